@@ -1,0 +1,143 @@
+"""Vectorised planar geometry helpers. Points are ``(n, 2)`` arrays, poses ``(n, 3)``.
+
+Polygons are ``(k, 2)`` vertex arrays in order (either orientation), implicitly closed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+def wrap_angle(a: ArrayLike) -> FloatArray:
+    """Wrap angles (any shape) to ``[-pi, pi)``."""
+    return (np.asarray(a, dtype=np.float64) + np.pi) % (2.0 * np.pi) - np.pi
+
+
+def rotation_matrix(theta: float) -> FloatArray:
+    """The 2×2 rotation matrix for ``theta`` (rad)."""
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([[c, -s], [s, c]])
+
+
+def transform_points(points: ArrayLike, pose: ArrayLike) -> FloatArray:
+    """Map body-frame points ``(k, 2)`` to the world with ``pose = [x, y, theta]``.
+
+    ``pose`` may also be ``(n, 3)``; the result is then ``(n, k, 2)``.
+    """
+    p = np.asarray(points, dtype=np.float64)
+    q = np.asarray(pose, dtype=np.float64)
+    c, s = np.cos(q[..., 2]), np.sin(q[..., 2])
+    x = c[..., None] * p[:, 0] - s[..., None] * p[:, 1] + q[..., 0, None]
+    y = s[..., None] * p[:, 0] + c[..., None] * p[:, 1] + q[..., 1, None]
+    return np.stack([x, y], axis=-1)
+
+
+def to_body_frame(points: ArrayLike, pose: ArrayLike) -> FloatArray:
+    """Inverse of :func:`transform_points` for one pose: world points ``(k, 2)`` → body frame."""
+    p = np.asarray(points, dtype=np.float64) - np.asarray(pose, dtype=np.float64)[:2]
+    c, s = np.cos(pose[2]), np.sin(pose[2])
+    return np.stack([c * p[:, 0] + s * p[:, 1], -s * p[:, 0] + c * p[:, 1]], axis=-1)
+
+
+def rectangle(length: float, width: float, center: tuple[float, float] = (0.0, 0.0)) -> FloatArray:
+    """Counter-clockwise rectangle ``(4, 2)``: ``length`` along x, ``width`` along y (m)."""
+    hx, hy = length / 2.0, width / 2.0
+    cx, cy = center
+    return np.array([[cx - hx, cy - hy], [cx + hx, cy - hy], [cx + hx, cy + hy], [cx - hx, cy + hy]])
+
+
+def regular_polygon(radius: float, sides: int = 16) -> FloatArray:
+    """Counter-clockwise regular polygon inscribed in a circle of ``radius`` (m)."""
+    t = np.linspace(0.0, 2.0 * np.pi, sides, endpoint=False)
+    return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=-1)
+
+
+def polygon_area(polygon: ArrayLike) -> float:
+    """Signed area (m²): positive for counter-clockwise vertex order."""
+    p = np.asarray(polygon, dtype=np.float64)
+    x, y = p[:, 0], p[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+
+
+def polygon_edges(polygon: ArrayLike) -> tuple[FloatArray, FloatArray]:
+    """Edge start and end points, each ``(k, 2)``."""
+    a = np.asarray(polygon, dtype=np.float64)
+    return a, np.roll(a, -1, axis=0)
+
+
+def bounding_radius(polygon: ArrayLike) -> float:
+    """Largest distance of a vertex from the origin (m): the circumscribed radius about (0, 0)."""
+    return float(np.max(np.linalg.norm(np.asarray(polygon, dtype=np.float64), axis=1)))
+
+
+def points_in_polygon(points: ArrayLike, polygon: ArrayLike) -> NDArray[np.bool_]:
+    """Even-odd rule test for ``(n, 2)`` points against one polygon → ``(n,)`` bool."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    a, b = polygon_edges(polygon)
+    px, py = p[:, 0:1], p[:, 1:2]
+    crosses = (a[:, 1] > py) != (b[:, 1] > py)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x_at = a[:, 0] + (py - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    return np.count_nonzero(crosses & (px < x_at), axis=1) % 2 == 1
+
+
+def point_segment_distance(points: ArrayLike, a: ArrayLike, b: ArrayLike) -> FloatArray:
+    """Distances from ``(n, 2)`` points to ``(m, 2)`` segments ``a→b`` → ``(n, m)`` in metres."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 1, 2)
+    a = np.asarray(a, dtype=np.float64).reshape(1, -1, 2)
+    b = np.asarray(b, dtype=np.float64).reshape(1, -1, 2)
+    ab = b - a
+    denom = np.einsum("...i,...i->...", ab, ab)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.einsum("...i,...i->...", p - a, ab) / denom
+    t = np.clip(np.nan_to_num(t, nan=0.0), 0.0, 1.0)
+    closest = a + t[..., None] * ab
+    return np.linalg.norm(p - closest, axis=-1)
+
+
+def segments_intersect(a1: ArrayLike, b1: ArrayLike, a2: ArrayLike, b2: ArrayLike) -> NDArray[np.bool_]:
+    """Pairwise proper-or-touching intersection of segments ``(n, 2)`` × ``(m, 2)`` → ``(n, m)``."""
+    p = np.asarray(a1, dtype=np.float64).reshape(-1, 1, 2)
+    r = np.asarray(b1, dtype=np.float64).reshape(-1, 1, 2) - p
+    q = np.asarray(a2, dtype=np.float64).reshape(1, -1, 2)
+    s = np.asarray(b2, dtype=np.float64).reshape(1, -1, 2) - q
+    qp = q - p
+    rxs = r[..., 0] * s[..., 1] - r[..., 1] * s[..., 0]
+    qpxr = qp[..., 0] * r[..., 1] - qp[..., 1] * r[..., 0]
+    qpxs = qp[..., 0] * s[..., 1] - qp[..., 1] * s[..., 0]
+    parallel = np.abs(rxs) < 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = qpxs / rxs
+        u = qpxr / rxs
+    hit = ~parallel & (t >= 0) & (t <= 1) & (u >= 0) & (u <= 1)
+    # Collinear overlapping segments count as intersecting.
+    collinear = parallel & (np.abs(qpxr) < 1e-12)
+    if np.any(collinear):
+        rr = np.einsum("...i,...i->...", r, r)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t0 = np.einsum("...i,...i->...", qp, r) / rr
+            t1 = t0 + np.einsum("...i,...i->...", s, r) / rr
+        lo, hi = np.minimum(t0, t1), np.maximum(t0, t1)
+        hit |= collinear & (hi >= 0) & (lo <= 1)
+    return hit
+
+
+def circles_overlap_polygon(centers: ArrayLike, radii: ArrayLike, polygon: ArrayLike) -> NDArray[np.bool_]:
+    """Whether each circle ``(n,)`` touches or lies inside one polygon → ``(n,)`` bool."""
+    c = np.asarray(centers, dtype=np.float64).reshape(-1, 2)
+    r = np.asarray(radii, dtype=np.float64).reshape(-1)
+    a, b = polygon_edges(polygon)
+    near_edge = np.min(point_segment_distance(c, a, b), axis=1) <= r
+    return near_edge | points_in_polygon(c, polygon)
+
+
+def polygons_overlap(p: ArrayLike, q: ArrayLike) -> bool:
+    """Whether two polygons intersect (edges cross, or one contains the other)."""
+    pa, pb = polygon_edges(p)
+    qa, qb = polygon_edges(q)
+    if np.any(segments_intersect(pa, pb, qa, qb)):
+        return True
+    return bool(points_in_polygon(pa[:1], q)[0] or points_in_polygon(qa[:1], p)[0])

@@ -1,0 +1,213 @@
+"""The one plugin registry used by every plugin kind.
+
+A registry maps stable snake_case names to classes. A class may declare a nested pydantic
+``Params`` model; :meth:`Registry.build` validates a flat YAML block ``{type: name, **params}``
+against it and constructs ``cls(params)``. Third-party packages add plugins through Python entry
+points in the group given at construction (loaded lazily, on first lookup).
+
+Example::
+
+    LOCAL_PLANNERS: Registry[LocalPlanner] = Registry("local planner", entry_points="arena.local_planners")
+
+    @LOCAL_PLANNERS.register("pure_pursuit", tags=("classic",))
+    class PurePursuitPlanner:
+        class Params(BaseModel, frozen=True, extra="forbid"):
+            lookahead: float = Field(0.8, gt=0, description="m")
+        def __init__(self, params: Params) -> None: ...
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass
+from importlib.metadata import entry_points as _entry_points
+from typing import Any, Generic, TypeVar
+
+from pydantic import BaseModel, ValidationError
+
+from arena.core.errors import ConfigError, UnknownNameError, from_validation_error
+
+T = TypeVar("T")
+
+_ALL: dict[str, Registry[Any]] = {}
+
+
+@dataclass(frozen=True)
+class Entry(Generic[T]):
+    """One registered plugin."""
+
+    name: str
+    obj: type[T] | Callable[..., T]
+    tags: tuple[str, ...]
+
+    @property
+    def params_model(self) -> type[BaseModel] | None:
+        """The plugin's nested ``Params`` model, or ``None`` if it takes no parameters."""
+        params = getattr(self.obj, "Params", None)
+        return params if isinstance(params, type) and issubclass(params, BaseModel) else None
+
+    @property
+    def summary(self) -> str:
+        """First line of the plugin's docstring."""
+        doc = (getattr(self.obj, "__doc__", None) or "").strip()
+        return doc.splitlines()[0] if doc else ""
+
+
+class Registry(Generic[T]):
+    """A named collection of plugins of one kind.
+
+    Args:
+        kind: human name of the plugin kind, used in messages ("local planner").
+        entry_points: entry-point group scanned for third-party plugins ("arena.local_planners").
+    """
+
+    def __init__(self, kind: str, *, entry_points: str | None = None) -> None:
+        if kind in _ALL:
+            raise ValueError(f"a registry for {kind!r} already exists")
+        self.kind = kind
+        self.entry_point_group = entry_points
+        self._entries: dict[str, Entry[T]] = {}
+        self._entry_points_loaded = entry_points is None
+        _ALL[kind] = self
+
+    # -- registration -----------------------------------------------------------------------
+    def register(self, name: str, *, tags: tuple[str, ...] = ()) -> Callable[[Any], Any]:
+        """Class decorator that registers the class under ``name``."""
+
+        def deco(obj: Any) -> Any:
+            self.add(name, obj, tags=tags)
+            return obj
+
+        return deco
+
+    def add(self, name: str, obj: Any, *, tags: tuple[str, ...] = ()) -> None:
+        """Register ``obj`` under ``name``; a second plugin with the same name is an error."""
+        if not name or name != name.strip() or " " in name:
+            raise ValueError(f"invalid {self.kind} name {name!r}")
+        if name in self._entries and self._entries[name].obj is not obj:
+            raise ValueError(
+                f"duplicate {self.kind} name {name!r}: already registered by "
+                f"{_qualname(self._entries[name].obj)}, now {_qualname(obj)}"
+            )
+        self._entries[name] = Entry(name=name, obj=obj, tags=tuple(tags))
+
+    # -- lookup -----------------------------------------------------------------------------
+    def _load_entry_points(self) -> None:
+        if self._entry_points_loaded:
+            return
+        self._entry_points_loaded = True
+        for ep in _entry_points(group=self.entry_point_group or ""):
+            if ep.name in self._entries:
+                continue  # built-in wins; the duplicate guard is for code registrations
+            self.add(ep.name, ep.load(), tags=("third_party",))
+
+    def entry(self, name: str) -> Entry[T]:
+        """The :class:`Entry` for ``name``; unknown names raise with a close match."""
+        self._load_entry_points()
+        try:
+            return self._entries[name]
+        except KeyError:
+            raise UnknownNameError(self.unknown_message(name)) from None
+
+    def get(self, name: str) -> Any:
+        """The registered class (or factory) for ``name``."""
+        return self.entry(name).obj
+
+    def unknown_message(self, name: object) -> str:
+        """Message for an unknown name: the close match first, then every known name."""
+        known = self.names()
+        close = difflib.get_close_matches(str(name), known, n=1, cutoff=0.5)
+        hint = f"did you mean {close[0]!r}? " if close else ""
+        return f"unknown {self.kind} {name!r}; {hint}known: {', '.join(known) or '(none)'}"
+
+    def names(self, tag: str | None = None) -> list[str]:
+        """Sorted registered names, optionally only those carrying ``tag``."""
+        self._load_entry_points()
+        return sorted(n for n, e in self._entries.items() if tag is None or tag in e.tags)
+
+    def entries(self) -> list[Entry[T]]:
+        """All entries, sorted by name."""
+        self._load_entry_points()
+        return [self._entries[n] for n in sorted(self._entries)]
+
+    def __contains__(self, name: object) -> bool:
+        self._load_entry_points()
+        return name in self._entries
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.names())
+
+    def __len__(self) -> int:
+        self._load_entry_points()
+        return len(self._entries)
+
+    # -- construction -----------------------------------------------------------------------
+    def validate(
+        self, spec: Mapping[str, Any] | str, *, source: str | None = None, path: str | None = None
+    ) -> tuple[Entry[T], BaseModel | None]:
+        """Check a ``{type: name, **params}`` block; return the entry and its validated params.
+
+        Raises:
+            ConfigError: naming ``source`` and the key path when the block is invalid.
+        """
+        if isinstance(spec, str):
+            spec = {"type": spec}
+        if not isinstance(spec, Mapping):
+            raise ConfigError(
+                f"expected a mapping with a 'type' key or a {self.kind} name, got {spec!r}",
+                source=source, path=path,
+            )
+        if "type" not in spec:
+            raise ConfigError(
+                f"missing 'type' (one of: {', '.join(self.names())})",
+                source=source, path=path,
+            )
+        try:
+            entry = self.entry(spec["type"])
+        except UnknownNameError as e:
+            raise UnknownNameError(
+                e.message, source=source, path=".".join(p for p in (path, "type") if p)
+            ) from None
+        raw = {k: v for k, v in spec.items() if k != "type"}
+        model = entry.params_model
+        if model is None:
+            if raw:
+                raise ConfigError(
+                    f"{self.kind} {entry.name!r} takes no parameters, got {sorted(raw)}",
+                    source=source, path=path,
+                )
+            return entry, None
+        try:
+            return entry, model.model_validate(raw)
+        except ValidationError as e:
+            raise from_validation_error(e, source=source, prefix=path) from None
+
+    def build(
+        self,
+        spec: Mapping[str, Any] | str,
+        *args: Any,
+        source: str | None = None,
+        path: str | None = None,
+        **kwargs: Any,
+    ) -> T:
+        """Validate ``spec`` and construct the plugin: ``cls(params, *args, **kwargs)``.
+
+        Plugins without a ``Params`` model are constructed as ``cls(*args, **kwargs)``.
+        """
+        entry, params = self.validate(spec, source=source, path=path)
+        if params is None:
+            return entry.obj(*args, **kwargs)
+        return entry.obj(params, *args, **kwargs)
+
+    def __repr__(self) -> str:
+        return f"Registry({self.kind!r}, {len(self._entries)} entries)"
+
+
+def all_registries() -> dict[str, Registry[Any]]:
+    """Every registry created so far, by kind (import :mod:`arena.plugins` first to fill them)."""
+    return dict(_ALL)
+
+
+def _qualname(obj: Any) -> str:
+    return f"{getattr(obj, '__module__', '?')}.{getattr(obj, '__qualname__', repr(obj))}"

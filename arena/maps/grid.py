@@ -1,0 +1,205 @@
+"""The occupancy grid: one map raster with its world placement.
+
+Cell values follow ``nav_msgs/OccupancyGrid``: ``0`` free, ``100`` occupied, ``-1`` unknown.
+Row 0 of :attr:`OccupancyGrid.data` is the row at the map origin (lowest y), as in ROS messages;
+images on disk have row 0 at the top, so :mod:`arena.maps.io` flips them on load and save.
+
+The cell ``(row, col)`` covers ``x ∈ [ox + col·res, ox + (col+1)·res)`` and
+``y ∈ [oy + row·res, oy + (row+1)·res)``; its centre is half a cell further.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
+
+from arena.core.errors import MapError
+
+FREE = 0
+OCCUPIED = 100
+UNKNOWN = -1
+
+
+@dataclass(frozen=True, eq=False)
+class OccupancyGrid:
+    """An occupancy grid map.
+
+    Attributes:
+        data: ``(height, width)`` int8 cells: 0 free, 100 occupied, -1 unknown; row 0 at ``origin``.
+        resolution: cell edge length (m).
+        origin: world position ``(x, y)`` of the lower-left corner of cell ``(0, 0)`` (m).
+        unknown_is_occupied: whether unknown cells block motion and lidar (default: no, as
+            Arena's flatland treats only occupied pixels as walls).
+    """
+
+    data: NDArray[np.int8]
+    resolution: float
+    origin: tuple[float, float] = (0.0, 0.0)
+    unknown_is_occupied: bool = False
+
+    def __post_init__(self) -> None:
+        data = np.ascontiguousarray(self.data, dtype=np.int8)
+        if data.ndim != 2 or data.shape[0] < 1 or data.shape[1] < 1:
+            raise MapError(f"occupancy data must be a non-empty 2-D array, got shape {data.shape}")
+        bad = ~np.isin(data, (FREE, OCCUPIED, UNKNOWN))
+        if np.any(bad):
+            raise MapError(
+                f"occupancy values must be 0 (free), 100 (occupied) or -1 (unknown); "
+                f"found {sorted(set(np.unique(data[bad]).tolist()))[:5]}"
+            )
+        if not (self.resolution > 0 and np.isfinite(self.resolution)):
+            raise MapError(f"resolution must be a positive number of metres, got {self.resolution!r}")
+        data.setflags(write=False)
+        object.__setattr__(self, "data", data)
+        object.__setattr__(self, "resolution", float(self.resolution))
+        object.__setattr__(self, "origin", (float(self.origin[0]), float(self.origin[1])))
+
+    # -- construction ---------------------------------------------------------------------------
+    @classmethod
+    def from_occupied(
+        cls, occupied: ArrayLike, resolution: float, origin: tuple[float, float] = (0.0, 0.0)
+    ) -> OccupancyGrid:
+        """Build from a boolean ``(height, width)`` mask (True = occupied), row 0 at ``origin``."""
+        mask = np.asarray(occupied, dtype=bool)
+        return cls(np.where(mask, OCCUPIED, FREE).astype(np.int8), resolution, origin)
+
+    @classmethod
+    def empty(
+        cls, width_m: float, height_m: float, resolution: float = 0.05, *, walls: bool = True,
+        origin: tuple[float, float] = (0.0, 0.0),
+    ) -> OccupancyGrid:
+        """A free rectangle of ``width_m × height_m`` metres, with a one-cell wall border if asked."""
+        w = round(width_m / resolution)
+        h = round(height_m / resolution)
+        occ = np.zeros((h, w), dtype=bool)
+        if walls:
+            occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+        return cls.from_occupied(occ, resolution, origin)
+
+    # -- shape ----------------------------------------------------------------------------------
+    @property
+    def height(self) -> int:
+        """Number of rows."""
+        return int(self.data.shape[0])
+
+    @property
+    def width(self) -> int:
+        """Number of columns."""
+        return int(self.data.shape[1])
+
+    @property
+    def size_m(self) -> tuple[float, float]:
+        """World extent ``(width, height)`` in metres."""
+        return self.width * self.resolution, self.height * self.resolution
+
+    @property
+    def bounds(self) -> tuple[float, float, float, float]:
+        """``(xmin, ymin, xmax, ymax)`` of the mapped area (m)."""
+        w, h = self.size_m
+        return self.origin[0], self.origin[1], self.origin[0] + w, self.origin[1] + h
+
+    # -- masks ----------------------------------------------------------------------------------
+    @cached_property
+    def occupied(self) -> NDArray[np.bool_]:
+        """``(height, width)`` bool: cells that block motion and lidar."""
+        occ = self.data == OCCUPIED
+        if self.unknown_is_occupied:
+            occ |= self.data == UNKNOWN
+        occ.setflags(write=False)
+        return occ
+
+    @cached_property
+    def free(self) -> NDArray[np.bool_]:
+        """``(height, width)`` bool: cells known to be free."""
+        m = self.data == FREE
+        m.setflags(write=False)
+        return m
+
+    @cached_property
+    def distance(self) -> NDArray[np.float64]:
+        """Euclidean distance (m) from each cell centre to the nearest blocking cell centre.
+
+        Blocking cells get 0. A map with no blocking cell gets ``inf`` everywhere. Cells outside
+        the map are not treated as walls here: the simulator bounds positions separately.
+        """
+        occ = self.occupied
+        if not occ.any():
+            d = np.full(occ.shape, np.inf)
+        else:
+            d = ndimage.distance_transform_edt(~occ) * self.resolution
+        d.setflags(write=False)
+        return d
+
+    # -- transforms ------------------------------------------------------------------------------
+    def world_to_cell(self, xy: ArrayLike) -> NDArray[np.int64]:
+        """World points ``(..., 2)`` → integer cells ``(..., 2)`` as ``[row, col]`` (may be off-map)."""
+        p = np.asarray(xy, dtype=np.float64)
+        col = np.floor((p[..., 0] - self.origin[0]) / self.resolution).astype(np.int64)
+        row = np.floor((p[..., 1] - self.origin[1]) / self.resolution).astype(np.int64)
+        return np.stack([row, col], axis=-1)
+
+    def cell_to_world(self, cells: ArrayLike) -> NDArray[np.float64]:
+        """Cells ``(..., 2)`` as ``[row, col]`` → world coordinates ``(..., 2)`` of their centres."""
+        c = np.asarray(cells, dtype=np.float64)
+        x = self.origin[0] + (c[..., 1] + 0.5) * self.resolution
+        y = self.origin[1] + (c[..., 0] + 0.5) * self.resolution
+        return np.stack([x, y], axis=-1)
+
+    def in_bounds(self, cells: ArrayLike) -> NDArray[np.bool_]:
+        """Whether ``[row, col]`` cells ``(..., 2)`` lie on the map."""
+        c = np.asarray(cells)
+        return (c[..., 0] >= 0) & (c[..., 0] < self.height) & (c[..., 1] >= 0) & (c[..., 1] < self.width)
+
+    def contains(self, xy: ArrayLike) -> NDArray[np.bool_]:
+        """Whether world points ``(..., 2)`` lie on the map."""
+        return self.in_bounds(self.world_to_cell(xy))
+
+    def is_occupied(self, xy: ArrayLike) -> NDArray[np.bool_]:
+        """Whether world points ``(..., 2)`` fall in blocking cells; off-map points count as blocked."""
+        cells = self.world_to_cell(xy)
+        inside = self.in_bounds(cells)
+        r = np.clip(cells[..., 0], 0, self.height - 1)
+        c = np.clip(cells[..., 1], 0, self.width - 1)
+        return ~inside | self.occupied[r, c]
+
+    def distance_at(self, xy: ArrayLike) -> NDArray[np.float64]:
+        """:attr:`distance` looked up at world points ``(..., 2)``; 0 off the map."""
+        cells = self.world_to_cell(xy)
+        inside = self.in_bounds(cells)
+        r = np.clip(cells[..., 0], 0, self.height - 1)
+        c = np.clip(cells[..., 1], 0, self.width - 1)
+        return np.where(inside, self.distance[r, c], 0.0)
+
+    # -- derived maps -----------------------------------------------------------------------------
+    def inflate(self, radius: float) -> OccupancyGrid:
+        """A copy where every cell whose centre lies within ``radius`` (m) of a blocking cell centre
+        is occupied. Unknown cells stay unknown unless inflated over."""
+        if radius < 0:
+            raise MapError(f"inflation radius must be >= 0 m, got {radius}")
+        grown = self.distance <= radius + 1e-9
+        data = np.where(grown, OCCUPIED, self.data).astype(np.int8)
+        return OccupancyGrid(data, self.resolution, self.origin, self.unknown_is_occupied)
+
+    def with_occupied(self, mask: ArrayLike) -> OccupancyGrid:
+        """A copy with the cells of a boolean ``(height, width)`` mask set occupied."""
+        m = np.asarray(mask, dtype=bool)
+        if m.shape != self.data.shape:
+            raise MapError(f"mask shape {m.shape} does not match the map {self.data.shape}")
+        data = np.where(m, OCCUPIED, self.data).astype(np.int8)
+        return OccupancyGrid(data, self.resolution, self.origin, self.unknown_is_occupied)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, OccupancyGrid):
+            return NotImplemented
+        return (
+            self.resolution == other.resolution
+            and self.origin == other.origin
+            and self.unknown_is_occupied == other.unknown_is_occupied
+            and np.array_equal(self.data, other.data)
+        )
+
+    __hash__ = None  # type: ignore[assignment]

@@ -1,0 +1,58 @@
+"""Sensor specifications as validated data (shared by robot presets and the sensor code)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+
+class LidarSpec(BaseModel):
+    """A planar laser scanner, as in Arena's ``model_params.yaml`` ``laser`` block.
+
+    Beam ``i`` points at ``angle_min + i · angle_increment`` in the sensor frame. A scan covering
+    the full circle (``angle_max - angle_min`` ≥ 2π − 1e-3) spreads ``num_beams`` beams evenly
+    without repeating the first beam; otherwise the first and last beams sit at ``angle_min`` and
+    ``angle_max``.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    angle_min: float = Field(description="rad, first beam angle in the sensor frame")
+    angle_max: float = Field(description="rad, last beam angle in the sensor frame")
+    num_beams: int = Field(gt=0, description="number of beams")
+    range_max: float = Field(gt=0, description="m, beams that hit nothing report this range")
+    range_min: float = Field(0.0, ge=0, description="m, returns closer than this report range_min")
+    update_rate: float = Field(10.0, gt=0, description="Hz")
+    noise_std: float = Field(0.0, ge=0, description="m, std of additive Gaussian range noise")
+    mount: tuple[float, float, float] = Field(
+        (0.0, 0.0, 0.0), description="sensor pose [x m, y m, yaw rad] in the robot base frame"
+    )
+
+    @model_validator(mode="after")
+    def _check(self) -> LidarSpec:
+        if self.angle_max < self.angle_min:
+            raise ValueError(f"angle_max ({self.angle_max}) must be >= angle_min ({self.angle_min})")
+        if self.angle_max - self.angle_min > 2 * math.pi + 1e-3:
+            raise ValueError("the scan spans more than a full circle")
+        if self.range_min >= self.range_max:
+            raise ValueError(f"range_min ({self.range_min}) must be < range_max ({self.range_max})")
+        return self
+
+    @property
+    def full_circle(self) -> bool:
+        """Whether the beams cover 360° (no duplicate beam at the seam)."""
+        return self.angle_max - self.angle_min >= 2 * math.pi - 1e-3
+
+    @property
+    def angle_increment(self) -> float:
+        """Angle between neighbouring beams (rad)."""
+        if self.full_circle:
+            return 2 * math.pi / self.num_beams
+        return (self.angle_max - self.angle_min) / max(self.num_beams - 1, 1)
+
+    def angles(self) -> NDArray[np.float64]:
+        """Beam angles in the sensor frame, shape ``(num_beams,)`` (rad)."""
+        return self.angle_min + self.angle_increment * np.arange(self.num_beams, dtype=np.float64)
