@@ -111,6 +111,7 @@ def from_validation_error(
         else:
             text = f"{e['msg']} (got {e.get('input')!r})"
         msgs.append((loc, text))
+
     def full(loc: str) -> str:
         return ".".join(p for p in (prefix, loc) if p)
 

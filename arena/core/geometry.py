@@ -46,7 +46,9 @@ def rectangle(length: float, width: float, center: tuple[float, float] = (0.0, 0
     """Counter-clockwise rectangle ``(4, 2)``: ``length`` along x, ``width`` along y (m)."""
     hx, hy = length / 2.0, width / 2.0
     cx, cy = center
-    return np.array([[cx - hx, cy - hy], [cx + hx, cy - hy], [cx + hx, cy + hy], [cx - hx, cy + hy]])
+    return np.array(
+        [[cx - hx, cy - hy], [cx + hx, cy - hy], [cx + hx, cy + hy], [cx - hx, cy + hy]]
+    )
 
 
 def regular_polygon(radius: float, sides: int = 16) -> FloatArray:
@@ -98,7 +100,9 @@ def point_segment_distance(points: ArrayLike, a: ArrayLike, b: ArrayLike) -> Flo
     return np.linalg.norm(p - closest, axis=-1)
 
 
-def segments_intersect(a1: ArrayLike, b1: ArrayLike, a2: ArrayLike, b2: ArrayLike) -> NDArray[np.bool_]:
+def segments_intersect(
+    a1: ArrayLike, b1: ArrayLike, a2: ArrayLike, b2: ArrayLike
+) -> NDArray[np.bool_]:
     """Pairwise proper-or-touching intersection of segments ``(n, 2)`` × ``(m, 2)`` → ``(n, m)``."""
     p = np.asarray(a1, dtype=np.float64).reshape(-1, 1, 2)
     r = np.asarray(b1, dtype=np.float64).reshape(-1, 1, 2) - p
@@ -125,7 +129,9 @@ def segments_intersect(a1: ArrayLike, b1: ArrayLike, a2: ArrayLike, b2: ArrayLik
     return hit
 
 
-def circles_overlap_polygon(centers: ArrayLike, radii: ArrayLike, polygon: ArrayLike) -> NDArray[np.bool_]:
+def circles_overlap_polygon(
+    centers: ArrayLike, radii: ArrayLike, polygon: ArrayLike
+) -> NDArray[np.bool_]:
     """Whether each circle ``(n,)`` touches or lies inside one polygon → ``(n,)`` bool."""
     c = np.asarray(centers, dtype=np.float64).reshape(-1, 2)
     r = np.asarray(radii, dtype=np.float64).reshape(-1)
@@ -141,3 +147,51 @@ def polygons_overlap(p: ArrayLike, q: ArrayLike) -> bool:
     if np.any(segments_intersect(pa, pb, qa, qb)):
         return True
     return bool(points_in_polygon(pa[:1], q)[0] or points_in_polygon(qa[:1], p)[0])
+
+
+def convex_hull(points: ArrayLike) -> FloatArray:
+    """Counter-clockwise convex hull ``(h, 2)`` of ``(n, 2)`` points (Andrew's monotone chain)."""
+    p = np.unique(np.asarray(points, dtype=np.float64).reshape(-1, 2), axis=0)
+    if len(p) <= 2:
+        return p
+
+    def half(pts: FloatArray) -> list[FloatArray]:
+        out: list[FloatArray] = []
+        for q in pts:
+            while len(out) >= 2:
+                o, a = out[-2], out[-1]
+                if (a[0] - o[0]) * (q[1] - o[1]) - (a[1] - o[1]) * (q[0] - o[0]) > 0:
+                    break
+                out.pop()
+            out.append(q)
+        return out
+
+    lower, upper = half(p), half(p[::-1])
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def convex_polygon_overlaps_squares(
+    polygon: ArrayLike, centers: ArrayLike, half_size: float
+) -> NDArray[np.bool_]:
+    """Separating-axis test of one convex polygon against axis-aligned squares.
+
+    Args:
+        polygon: ``(k, 2)`` convex polygon (world frame).
+        centers: ``(m, 2)`` square centres.
+        half_size: half the square's edge length (m).
+
+    Returns:
+        ``(m,)`` bool, True where the interiors overlap (touching edges do not count).
+    """
+    poly = np.asarray(polygon, dtype=np.float64)
+    c = np.asarray(centers, dtype=np.float64).reshape(-1, 2)
+    ok = (c[:, 0] - half_size < poly[:, 0].max()) & (c[:, 0] + half_size > poly[:, 0].min())
+    ok &= (c[:, 1] - half_size < poly[:, 1].max()) & (c[:, 1] + half_size > poly[:, 1].min())
+    edges = np.roll(poly, -1, axis=0) - poly
+    normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1)  # (k, 2)
+    proj_poly = poly @ normals.T  # (k_vertices, k_axes)
+    pmin, pmax = proj_poly.min(axis=0), proj_poly.max(axis=0)
+    proj_c = c @ normals.T  # (m, k_axes)
+    extent = half_size * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
+    ok &= np.all((proj_c - extent < pmax) & (proj_c + extent > pmin), axis=1)
+    return ok

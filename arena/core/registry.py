@@ -7,7 +7,9 @@ points in the group given at construction (loaded lazily, on first lookup).
 
 Example::
 
-    LOCAL_PLANNERS: Registry[LocalPlanner] = Registry("local planner", entry_points="arena.local_planners")
+    LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
+        "local planner", entry_points="arena.local_planners"
+    )
 
     @LOCAL_PLANNERS.register("pure_pursuit", tags=("classic",))
     class PurePursuitPlanner:
@@ -156,12 +158,14 @@ class Registry(Generic[T]):
         if not isinstance(spec, Mapping):
             raise ConfigError(
                 f"expected a mapping with a 'type' key or a {self.kind} name, got {spec!r}",
-                source=source, path=path,
+                source=source,
+                path=path,
             )
         if "type" not in spec:
             raise ConfigError(
                 f"missing 'type' (one of: {', '.join(self.names())})",
-                source=source, path=path,
+                source=source,
+                path=path,
             )
         try:
             entry = self.entry(spec["type"])
@@ -175,7 +179,8 @@ class Registry(Generic[T]):
             if raw:
                 raise ConfigError(
                     f"{self.kind} {entry.name!r} takes no parameters, got {sorted(raw)}",
-                    source=source, path=path,
+                    source=source,
+                    path=path,
                 )
             return entry, None
         try:

@@ -42,17 +42,24 @@ class OccupancyGrid:
     unknown_is_occupied: bool = False
 
     def __post_init__(self) -> None:
-        data = np.ascontiguousarray(self.data, dtype=np.int8)
-        if data.ndim != 2 or data.shape[0] < 1 or data.shape[1] < 1:
-            raise MapError(f"occupancy data must be a non-empty 2-D array, got shape {data.shape}")
-        bad = ~np.isin(data, (FREE, OCCUPIED, UNKNOWN))
+        raw = np.asarray(self.data)
+        if raw.ndim != 2 or raw.shape[0] < 1 or raw.shape[1] < 1:
+            raise MapError(f"occupancy data must be a non-empty 2-D array, got shape {raw.shape}")
+        # Check before casting: int8 would wrap 255 to -1 and 356 to 100, and truncate 0.5 to 0.
+        bad = ~np.isin(raw, (FREE, OCCUPIED, UNKNOWN))
         if np.any(bad):
             raise MapError(
                 f"occupancy values must be 0 (free), 100 (occupied) or -1 (unknown); "
-                f"found {sorted(set(np.unique(data[bad]).tolist()))[:5]}"
+                f"found {sorted(set(np.unique(raw[bad]).tolist()))[:5]}"
             )
         if not (self.resolution > 0 and np.isfinite(self.resolution)):
-            raise MapError(f"resolution must be a positive number of metres, got {self.resolution!r}")
+            raise MapError(
+                f"resolution must be a positive number of metres, got {self.resolution!r}"
+            )
+        if len(self.origin) != 2 or not np.all(np.isfinite(self.origin)):
+            raise MapError(f"origin must be two finite coordinates (m), got {self.origin!r}")
+        # Own copy: freezing the caller's array in place would make *their* array read-only.
+        data = np.array(raw, dtype=np.int8, order="C", copy=True)
         data.setflags(write=False)
         object.__setattr__(self, "data", data)
         object.__setattr__(self, "resolution", float(self.resolution))
@@ -72,7 +79,7 @@ class OccupancyGrid:
         cls, width_m: float, height_m: float, resolution: float = 0.05, *, walls: bool = True,
         origin: tuple[float, float] = (0.0, 0.0),
     ) -> OccupancyGrid:
-        """A free rectangle of ``width_m × height_m`` metres, with a one-cell wall border if asked."""
+        """Build a free ``width_m × height_m`` (m) map, with a one-cell wall border if asked."""
         w = round(width_m / resolution)
         h = round(height_m / resolution)
         occ = np.zeros((h, w), dtype=bool)
@@ -136,14 +143,14 @@ class OccupancyGrid:
 
     # -- transforms ------------------------------------------------------------------------------
     def world_to_cell(self, xy: ArrayLike) -> NDArray[np.int64]:
-        """World points ``(..., 2)`` → integer cells ``(..., 2)`` as ``[row, col]`` (may be off-map)."""
+        """World points ``(..., 2)`` (m) → ``[row, col]`` cells ``(..., 2)`` (may be off-map)."""
         p = np.asarray(xy, dtype=np.float64)
         col = np.floor((p[..., 0] - self.origin[0]) / self.resolution).astype(np.int64)
         row = np.floor((p[..., 1] - self.origin[1]) / self.resolution).astype(np.int64)
         return np.stack([row, col], axis=-1)
 
     def cell_to_world(self, cells: ArrayLike) -> NDArray[np.float64]:
-        """Cells ``(..., 2)`` as ``[row, col]`` → world coordinates ``(..., 2)`` of their centres."""
+        """``[row, col]`` cells ``(..., 2)`` → world points ``(..., 2)`` of their centres (m)."""
         c = np.asarray(cells, dtype=np.float64)
         x = self.origin[0] + (c[..., 1] + 0.5) * self.resolution
         y = self.origin[1] + (c[..., 0] + 0.5) * self.resolution
@@ -152,14 +159,15 @@ class OccupancyGrid:
     def in_bounds(self, cells: ArrayLike) -> NDArray[np.bool_]:
         """Whether ``[row, col]`` cells ``(..., 2)`` lie on the map."""
         c = np.asarray(cells)
-        return (c[..., 0] >= 0) & (c[..., 0] < self.height) & (c[..., 1] >= 0) & (c[..., 1] < self.width)
+        rows_ok = (c[..., 0] >= 0) & (c[..., 0] < self.height)
+        return rows_ok & (c[..., 1] >= 0) & (c[..., 1] < self.width)
 
     def contains(self, xy: ArrayLike) -> NDArray[np.bool_]:
         """Whether world points ``(..., 2)`` lie on the map."""
         return self.in_bounds(self.world_to_cell(xy))
 
     def is_occupied(self, xy: ArrayLike) -> NDArray[np.bool_]:
-        """Whether world points ``(..., 2)`` fall in blocking cells; off-map points count as blocked."""
+        """Whether world points ``(..., 2)`` lie in blocking cells; off-map points are blocked."""
         cells = self.world_to_cell(xy)
         inside = self.in_bounds(cells)
         r = np.clip(cells[..., 0], 0, self.height - 1)
@@ -176,16 +184,19 @@ class OccupancyGrid:
 
     # -- derived maps -----------------------------------------------------------------------------
     def inflate(self, radius: float) -> OccupancyGrid:
-        """A copy where every cell whose centre lies within ``radius`` (m) of a blocking cell centre
-        is occupied. Unknown cells stay unknown unless inflated over."""
-        if radius < 0:
+        """Return a copy with every cell within ``radius`` (m) of a blocking cell occupied.
+
+        Distances are centre to centre (:attr:`distance`). Unknown cells stay unknown unless
+        inflated over.
+        """
+        if not radius >= 0:  # also rejects NaN, which would silently inflate nothing
             raise MapError(f"inflation radius must be >= 0 m, got {radius}")
         grown = self.distance <= radius + 1e-9
         data = np.where(grown, OCCUPIED, self.data).astype(np.int8)
         return OccupancyGrid(data, self.resolution, self.origin, self.unknown_is_occupied)
 
     def with_occupied(self, mask: ArrayLike) -> OccupancyGrid:
-        """A copy with the cells of a boolean ``(height, width)`` mask set occupied."""
+        """Return a copy with the cells of a boolean ``(height, width)`` mask set occupied."""
         m = np.asarray(mask, dtype=bool)
         if m.shape != self.data.shape:
             raise MapError(f"mask shape {m.shape} does not match the map {self.data.shape}")

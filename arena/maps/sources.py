@@ -1,0 +1,134 @@
+"""Where an experiment's map comes from: the ``map:`` block of a config.
+
+Every entry of :data:`MAP_SOURCES` turns its parameters (and a seeded generator, for procedural
+maps) into a :class:`MapResult`. The worlds and generators issue registers the procedural map
+generators here as well.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from arena.core.errors import ConfigError
+from arena.core.registry import Registry
+from arena.maps.grid import OccupancyGrid
+from arena.maps.io import load_map
+from arena.sim.state import Obstacle
+
+WORLDS_DIR = Path(__file__).resolve().parent.parent / "worlds"
+"""Folder of the worlds shipped with Arena (``<name>/map/map.yaml``, ``<name>/scenarios/``)."""
+
+
+@dataclass(frozen=True, eq=False)
+class MapResult:
+    """A map ready for an episode: its name, grid and any obstacles placed with it."""
+
+    name: str
+    grid: OccupancyGrid
+    obstacles: tuple[Obstacle, ...] = ()
+
+
+class MapSource(Protocol):
+    """Builds the map for an episode."""
+
+    def build(self, rng: np.random.Generator) -> MapResult:
+        """Return the map; procedural sources draw only from ``rng``."""
+        ...
+
+
+MAP_SOURCES: Registry[MapSource] = Registry("map source", entry_points="arena.map_sources")
+
+
+def packaged_worlds() -> list[str]:
+    """Names of the worlds shipped inside the package."""
+    if not WORLDS_DIR.is_dir():
+        return []
+    return sorted(p.name for p in WORLDS_DIR.iterdir() if (p / "map" / "map.yaml").is_file())
+
+
+def resolve_world(name_or_folder: str) -> Path:
+    """The ``map.yaml`` of a packaged world name or of a world folder in Arena's layout.
+
+    A folder may hold ``map/map.yaml`` (Arena-Rosnav's ``worlds/<name>/``) or ``map.yaml``.
+    """
+    folder = Path(name_or_folder).expanduser()
+    for candidate in (folder / "map" / "map.yaml", folder / "map.yaml"):
+        if candidate.is_file():
+            return candidate
+    packaged = WORLDS_DIR / name_or_folder / "map" / "map.yaml"
+    if "/" not in name_or_folder and packaged.is_file():
+        return packaged
+    import difflib
+
+    known = packaged_worlds()
+    close = difflib.get_close_matches(name_or_folder, known, n=1, cutoff=0.5)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise ConfigError(
+        f"no world {name_or_folder!r}: not a packaged world and not a folder with map/map.yaml; "
+        f"{hint}packaged worlds: {', '.join(known) or '(none)'}"
+    )
+
+
+@MAP_SOURCES.register("world", tags=("file",))
+class WorldMap:
+    """A packaged world by name, or any folder in Arena's layout (``<folder>/map/map.yaml``)."""
+
+    class Params(BaseModel):
+        """Parameters of :class:`WorldMap`."""
+
+        model_config = ConfigDict(frozen=True, extra="forbid")
+        name: str = Field(description="packaged world name or path to a world folder")
+
+    def __init__(self, params: Params) -> None:
+        self.params = params
+
+    def build(self, rng: np.random.Generator) -> MapResult:
+        """Load the world's map."""
+        path = resolve_world(self.params.name)
+        return MapResult(name=Path(self.params.name).name, grid=load_map(path))
+
+
+@MAP_SOURCES.register("file", tags=("file",))
+class FileMap:
+    """A ROS map_server ``map.yaml`` file (with its PGM/PNG image)."""
+
+    class Params(BaseModel):
+        """Parameters of :class:`FileMap`."""
+
+        model_config = ConfigDict(frozen=True, extra="forbid")
+        path: str = Field(description="path to a map_server map.yaml")
+
+    def __init__(self, params: Params) -> None:
+        self.params = params
+
+    def build(self, rng: np.random.Generator) -> MapResult:
+        """Load the map file."""
+        path = Path(self.params.path).expanduser()
+        name = path.parent.parent.name if path.parent.name == "map" else path.stem
+        return MapResult(name=name, grid=load_map(path))
+
+
+@MAP_SOURCES.register("empty", tags=("generator",))
+class EmptyMap:
+    """An empty rectangular room with walls around it."""
+
+    class Params(BaseModel):
+        """Parameters of :class:`EmptyMap`."""
+
+        model_config = ConfigDict(frozen=True, extra="forbid")
+        width: float = Field(10.0, gt=0, description="m")
+        height: float = Field(10.0, gt=0, description="m")
+        resolution: float = Field(0.05, gt=0, description="m per cell")
+
+    def __init__(self, params: Params) -> None:
+        self.params = params
+
+    def build(self, rng: np.random.Generator) -> MapResult:
+        """Build the room."""
+        p = self.params
+        return MapResult("empty", OccupancyGrid.empty(p.width, p.height, p.resolution))
