@@ -1,0 +1,15 @@
+"""Top-down frames, PNG stills and MP4/GIF videos of simulation states.
+
+This is the only package that imports matplotlib; it reads states and never changes them.
+
+Example:
+    >>> renderer = FrameRenderer(world, lidar_specs=[spec])  # doctest: +SKIP
+    >>> with VideoWriter("episode.mp4", fps=10) as video:  # doctest: +SKIP
+    ...     for state in states:
+    ...         video.append(renderer.render(state, Overlay(text="running")))
+"""
+
+from arena.render.frames import FrameRenderer, Overlay
+from arena.render.video import RenderError, VideoWriter, render_episode, save_png
+
+__all__ = ["FrameRenderer", "Overlay", "RenderError", "VideoWriter", "render_episode", "save_png"]
