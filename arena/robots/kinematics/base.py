@@ -1,0 +1,211 @@
+"""The kinematics contract, its registry, and the shared vectorised helpers.
+
+A kinematics model turns desired body twists into executed twists and new poses for ``n`` robots
+of one model at once. Every model runs the same pipeline in :meth:`Kinematics.step`:
+
+1. velocity limits on the command (the model's feasible velocity set),
+2. acceleration limits over ``dt`` from the previous executed twist (a per-axis "dynamic window",
+   as in DWA and ``diff_drive_controller``),
+3. kinematic constraints (no side slip, steering geometry ...),
+4. exact integration of the pose for a twist held constant over ``dt`` (zero-order hold), i.e.
+   motion along the circular arc, not an Euler step.
+
+Velocity limits are hard: where a previous twist lies outside the feasible set (a hand-made initial
+state), the result is brought back inside at once, even if that breaks an acceleration limit.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from arena.core.errors import SimulationError
+from arena.core.geometry import wrap_angle
+from arena.core.registry import Registry
+from arena.robots.limits import VelocityLimits
+
+FloatArray = NDArray[np.float64]
+
+
+@dataclass(frozen=True, eq=False)
+class KinematicState:
+    """Kinematic state of ``n`` robots of one model (a struct of arrays).
+
+    Attributes:
+        poses: ``(n, 3)`` world poses ``[x, y, theta]`` (m, m, rad).
+        twists: ``(n, 3)`` body-frame twists ``[vx, vy, omega]`` (m/s, m/s, rad/s) actually
+            executed during the last step (the starting point of the next acceleration window).
+        steering: ``(n,)`` front-wheel steering angle (rad); used by ``ackermann`` only, zeros
+            for every other model.
+    """
+
+    poses: FloatArray
+    twists: FloatArray
+    steering: FloatArray
+
+    def __post_init__(self) -> None:
+        poses = np.asarray(self.poses, dtype=np.float64)
+        twists = np.asarray(self.twists, dtype=np.float64)
+        steering = np.asarray(self.steering, dtype=np.float64)
+        if poses.ndim != 2 or poses.shape[1] != 3:
+            raise SimulationError(f"poses must have shape (n, 3), got {poses.shape}")
+        n = poses.shape[0]
+        if twists.shape != (n, 3):
+            raise SimulationError(f"twists must have shape ({n}, 3), got {twists.shape}")
+        if steering.shape != (n,):
+            raise SimulationError(f"steering must have shape ({n},), got {steering.shape}")
+        # frozen dataclass: the converted arrays are stored through object.__setattr__
+        object.__setattr__(self, "poses", poses)
+        object.__setattr__(self, "twists", twists)
+        object.__setattr__(self, "steering", steering)
+
+    @classmethod
+    def at_rest(cls, poses: ArrayLike) -> KinematicState:
+        """Robots standing still at ``poses`` ``(n, 3)`` with straight wheels."""
+        p = np.array(poses, dtype=np.float64).reshape(-1, 3)
+        n = p.shape[0]
+        return cls(p, np.zeros((n, 3)), np.zeros(n))
+
+    def __len__(self) -> int:
+        return int(self.poses.shape[0])
+
+
+@runtime_checkable
+class Kinematics(Protocol):
+    """A motion model for ``n`` robots of one kind, vectorised.
+
+    Attributes:
+        name: the registry key (``diff_drive`` ...).
+        holonomic: whether the model can move sideways (``vy ≠ 0``).
+        params: the validated ``Params`` model the instance was built from.
+    """
+
+    name: ClassVar[str]
+    params: Any
+
+    @property
+    def holonomic(self) -> bool:
+        """Whether the model can move sideways."""
+        ...
+
+    def limits(self) -> VelocityLimits:
+        """The box summary of the model's velocity and acceleration limits, for planners."""
+        ...
+
+    def step(self, state: KinematicState, commands: ArrayLike, dt: float) -> KinematicState:
+        """Advance ``n`` robots by ``dt`` seconds; pure (inputs are never mutated).
+
+        Args:
+            state: the current state of the ``n`` robots.
+            commands: ``(n, 3)`` desired body twists ``[vx, vy, omega]`` (m/s, m/s, rad/s).
+            dt: step length (s), > 0.
+
+        Returns:
+            The new state: poses after ``dt``, the twists executed during the step, steering.
+
+        Raises:
+            SimulationError: on a wrong command shape, non-finite commands or ``dt <= 0``.
+        """
+        ...
+
+
+KINEMATICS: Registry[Kinematics] = Registry("kinematics", entry_points="arena.kinematics")
+
+
+# -- helpers shared by the models -------------------------------------------------------------
+def check_step_inputs(state: KinematicState, commands: ArrayLike, dt: float) -> FloatArray:
+    """Validate ``commands`` against ``state`` and ``dt``; return them as a new ``(n, 3)`` array."""
+    if not (np.isfinite(dt) and dt > 0):
+        raise SimulationError(f"dt must be a finite number > 0, got {dt!r}")
+    cmd = np.array(commands, dtype=np.float64)  # a copy: the caller's array is never touched
+    n = len(state)
+    if cmd.shape != (n, 3):
+        raise SimulationError(f"commands must have shape ({n}, 3) for {n} robots, got {cmd.shape}")
+    if not np.all(np.isfinite(cmd)):
+        bad = np.flatnonzero(~np.all(np.isfinite(cmd), axis=1)).tolist()
+        raise SimulationError(f"non-finite commands for robots {bad}")
+    return cmd
+
+
+def rate_limit(current: FloatArray, target: FloatArray, max_delta: ArrayLike) -> FloatArray:
+    """Move ``current`` toward ``target`` by at most ``max_delta`` per component (any shape).
+
+    ``max_delta`` may be ``inf`` (no limit); the result equals ``target`` then.
+    """
+    lim = np.asarray(max_delta, dtype=np.float64)
+    return current + np.clip(target - current, -lim, lim)
+
+
+def integrate_twist(poses: FloatArray, twists: FloatArray, dt: float) -> FloatArray:
+    """Exact pose after holding each body twist constant for ``dt`` (the SE(2) exponential).
+
+    For ``phi = omega·dt`` the body-frame displacement is
+    ``[S·vx − C·vy, C·vx + S·vy]`` with ``S = sin(phi)/omega`` and ``C = (1 − cos phi)/omega``,
+    written through ``np.sinc`` so that ``omega → 0`` needs no special case (straight line).
+
+    Args:
+        poses: ``(n, 3)`` start poses ``[x, y, theta]``.
+        twists: ``(n, 3)`` body twists ``[vx, vy, omega]``.
+        dt: duration (s).
+
+    Returns:
+        ``(n, 3)`` end poses, heading wrapped to ``[-pi, pi)``.
+    """
+    vx, vy, om = twists[:, 0], twists[:, 1], twists[:, 2]
+    phi = om * dt
+    s = dt * np.sinc(phi / np.pi)  # sin(phi)/omega
+    c = dt * np.sin(0.5 * phi) * np.sinc(phi / (2.0 * np.pi))  # (1 - cos phi)/omega
+    dxb = s * vx - c * vy
+    dyb = c * vx + s * vy
+    th = poses[:, 2]
+    ct, st = np.cos(th), np.sin(th)
+    out = np.empty_like(poses)
+    out[:, 0] = poses[:, 0] + ct * dxb - st * dyb
+    out[:, 1] = poses[:, 1] + st * dxb + ct * dyb
+    out[:, 2] = wrap_angle(th + phi)
+    return out
+
+
+def quadric_norm(v: FloatArray, weights: FloatArray) -> FloatArray:
+    """``sqrt(Σ_i w_i v_i²)`` over the last axis: ≤ 1 inside the ellipsoid ``Σ w v² ≤ 1``."""
+    return np.sqrt(np.sum(weights * v * v, axis=-1))
+
+
+def larger_root(a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
+    """Larger real root of ``a·s² + b·s + c = 0`` per element, for ``a ≥ 0``.
+
+    Returns ``inf`` where ``a = 0`` (no quadratic growth: the bound is never reached) and 0 where
+    there is no non-negative real root (the start is already outside: do not move).
+    """
+    disc = b * b - 4.0 * a * c
+    sq = np.sqrt(np.maximum(disc, 0.0))
+    # the numerically stable form of (-b + sq) / 2a: no cancellation for b >= 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        root = np.where(b >= 0.0, -2.0 * c / (b + sq), (sq - b) / (2.0 * a))
+    # no real root, or only negative ones: the start is outside already, so do not move
+    root = np.where(np.isnan(root) | (disc < 0.0), 0.0, np.maximum(root, 0.0))
+    return np.where(a > 0.0, root, np.inf)
+
+
+def quadric_step_fraction(start: FloatArray, delta: FloatArray, weights: ArrayLike) -> FloatArray:
+    """Largest ``s`` with ``Σ_i w_i (start_i + s·delta_i)² ≤ 1``, per row.
+
+    Used to stop a twist on the boundary of an elliptical velocity limit: with ``start`` inside,
+    ``start + s·delta`` for ``s ∈ [0, result]`` stays inside.
+
+    Args:
+        start: ``(n, k)`` points (inside the ellipsoid for the result to be meaningful).
+        delta: ``(n, k)`` directions.
+        weights: ``(n, k)`` or ``(k,)`` non-negative inverse squared semi-axes.
+
+    Returns:
+        ``(n,)`` fractions; ``inf`` where ``delta`` has no weighted component.
+    """
+    w = np.asarray(weights, dtype=np.float64)
+    a = np.sum(w * delta * delta, axis=-1)
+    b = 2.0 * np.sum(w * start * delta, axis=-1)
+    c = np.sum(w * start * start, axis=-1) - 1.0
+    return larger_root(a, b, c)
