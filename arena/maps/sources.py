@@ -86,11 +86,14 @@ class WorldMap:
 
     def __init__(self, params: Params) -> None:
         self.params = params
+        self._result: MapResult | None = None
 
     def build(self, rng: np.random.Generator) -> MapResult:
-        """Load the world's map."""
-        path = resolve_world(self.params.name)
-        return MapResult(name=Path(self.params.name).name, grid=load_map(path))
+        """Load the world's map (read once per instance)."""
+        if self._result is None:
+            path = resolve_world(self.params.name)
+            self._result = MapResult(name=Path(self.params.name).name, grid=load_map(path))
+        return self._result
 
 
 @MAP_SOURCES.register("file", tags=("file",))
@@ -105,12 +108,15 @@ class FileMap:
 
     def __init__(self, params: Params) -> None:
         self.params = params
+        self._result: MapResult | None = None
 
     def build(self, rng: np.random.Generator) -> MapResult:
-        """Load the map file."""
-        path = Path(self.params.path).expanduser()
-        name = path.parent.parent.name if path.parent.name == "map" else path.stem
-        return MapResult(name=name, grid=load_map(path))
+        """Load the map file (read once per instance)."""
+        if self._result is None:
+            path = Path(self.params.path).expanduser()
+            name = path.parent.parent.name if path.parent.name == "map" else path.stem
+            self._result = MapResult(name=name, grid=load_map(path))
+        return self._result
 
 
 @MAP_SOURCES.register("empty", tags=("generator",))

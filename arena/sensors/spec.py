@@ -34,7 +34,9 @@ class LidarSpec(BaseModel):
     @model_validator(mode="after")
     def _check(self) -> LidarSpec:
         if self.angle_max < self.angle_min:
-            raise ValueError(f"angle_max ({self.angle_max}) must be >= angle_min ({self.angle_min})")
+            raise ValueError(
+                f"angle_max ({self.angle_max}) must be >= angle_min ({self.angle_min})"
+            )
         if self.angle_max - self.angle_min > 2 * math.pi + 1e-3:
             raise ValueError("the scan spans more than a full circle")
         if self.range_min >= self.range_max:

@@ -1,0 +1,1 @@
+"""The simulator interface, its registry and the backends."""

@@ -1,0 +1,1 @@
+"""Tasks: episode descriptions and the generators that sample them."""

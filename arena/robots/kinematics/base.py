@@ -16,14 +16,15 @@ state), the result is brought back inside at once, even if that breaks an accele
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import SimulationError
-from arena.core.geometry import wrap_angle
 from arena.core.registry import Registry
 from arena.robots.limits import VelocityLimits
 
@@ -143,8 +144,8 @@ def integrate_twist(poses: FloatArray, twists: FloatArray, dt: float) -> FloatAr
     """Exact pose after holding each body twist constant for ``dt`` (the SE(2) exponential).
 
     For ``phi = omega·dt`` the body-frame displacement is
-    ``[S·vx − C·vy, C·vx + S·vy]`` with ``S = sin(phi)/omega`` and ``C = (1 − cos phi)/omega``,
-    written through ``np.sinc`` so that ``omega → 0`` needs no special case (straight line).
+    ``[S·vx − C·vy, C·vx + S·vy]`` with ``S = sin(phi)/omega`` and ``C = (1 − cos phi)/omega``;
+    near ``omega = 0`` their Taylor series are used (straight line in the limit).
 
     Args:
         poses: ``(n, 3)`` start poses ``[x, y, theta]``.
@@ -154,19 +155,82 @@ def integrate_twist(poses: FloatArray, twists: FloatArray, dt: float) -> FloatAr
     Returns:
         ``(n, 3)`` end poses, heading wrapped to ``[-pi, pi)``.
     """
-    vx, vy, om = twists[:, 0], twists[:, 1], twists[:, 2]
-    phi = om * dt
-    s = dt * np.sinc(phi / np.pi)  # sin(phi)/omega
-    c = dt * np.sin(0.5 * phi) * np.sinc(phi / (2.0 * np.pi))  # (1 - cos phi)/omega
-    dxb = s * vx - c * vy
-    dyb = c * vx + s * vy
-    th = poses[:, 2]
-    ct, st = np.cos(th), np.sin(th)
-    out = np.empty_like(poses)
-    out[:, 0] = poses[:, 0] + ct * dxb - st * dyb
-    out[:, 1] = poses[:, 1] + st * dxb + ct * dyb
-    out[:, 2] = wrap_angle(th + phi)
+    out = np.empty((poses.shape[0], 3))
+    _integrate_kernel(
+        np.ascontiguousarray(poses, dtype=np.float64),
+        np.ascontiguousarray(twists, dtype=np.float64),
+        float(dt),
+        out,
+    )
     return out
+
+
+@njit(cache=True)
+def _integrate_kernel(poses: FloatArray, twists: FloatArray, dt: float, out: FloatArray) -> None:
+    for i in range(poses.shape[0]):
+        vx, vy, om = twists[i, 0], twists[i, 1], twists[i, 2]
+        phi = om * dt
+        if abs(phi) < 1e-4:
+            p2 = phi * phi
+            s = dt * (1.0 - p2 / 6.0 + p2 * p2 / 120.0)  # sin(phi)/omega
+            c = dt * phi * (0.5 - p2 / 24.0 + p2 * p2 / 720.0)  # (1 - cos phi)/omega
+        else:
+            s = math.sin(phi) / om
+            c = (1.0 - math.cos(phi)) / om
+        dxb = s * vx - c * vy
+        dyb = c * vx + s * vy
+        th = poses[i, 2]
+        ct, st = math.cos(th), math.sin(th)
+        out[i, 0] = poses[i, 0] + ct * dxb - st * dyb
+        out[i, 1] = poses[i, 1] + st * dxb + ct * dyb
+        out[i, 2] = (th + phi + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def box_step(
+    poses: FloatArray,
+    twists: FloatArray,
+    commands: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    acc: FloatArray,
+    dt: float,
+) -> tuple[FloatArray, FloatArray]:
+    """The whole pipeline for box velocity limits and per-axis acceleration limits, compiled.
+
+    Equivalent to ``target = clip(cmd)``, ``prev = clip(twist)``,
+    ``twist = clip(prev + clip(target - prev, ±acc·dt))`` and :func:`integrate_twist`; one call
+    instead of a dozen small numpy operations (the simulator's hot path for one robot).
+
+    Returns:
+        ``(poses, twists)``, each ``(n, 3)``.
+    """
+    n = poses.shape[0]
+    out_p = np.empty((n, 3))
+    out_t = np.empty((n, 3))
+    _box_kernel(poses, twists, commands, lower, upper, acc, float(dt), out_t)
+    _integrate_kernel(poses, out_t, float(dt), out_p)
+    return out_p, out_t
+
+
+@njit(cache=True)
+def _box_kernel(
+    poses: FloatArray,
+    twists: FloatArray,
+    cmd: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    acc: FloatArray,
+    dt: float,
+    out: FloatArray,
+) -> None:
+    for i in range(poses.shape[0]):
+        for k in range(3):
+            lo, hi = lower[k], upper[k]
+            target = min(max(cmd[i, k], lo), hi)
+            prev = min(max(twists[i, k], lo), hi)
+            step = acc[k] * dt
+            d = min(max(target - prev, -step), step)
+            out[i, k] = min(max(prev + d, lo), hi)
 
 
 def quadric_norm(v: FloatArray, weights: FloatArray) -> FloatArray:

@@ -12,9 +12,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 from arena.robots.kinematics.base import (
     KINEMATICS,
     KinematicState,
+    box_step,
     check_step_inputs,
-    integrate_twist,
-    rate_limit,
 )
 from arena.robots.limits import VelocityLimits
 
@@ -77,10 +76,8 @@ class DiffDriveKinematics:
     def step(self, state: KinematicState, commands: ArrayLike, dt: float) -> KinematicState:
         """Advance ``n`` robots by ``dt`` (see :meth:`Kinematics.step`)."""
         cmd = check_step_inputs(state, commands, dt)
-        target = np.clip(cmd, self._lower, self._upper)  # also forces vy = 0
-        # a hand-made state outside the limits is brought back at once (velocity limits win)
-        prev = np.clip(state.twists, self._lower, self._upper)
-        twist = rate_limit(prev, target, self._acc * dt)
-        twist = np.clip(twist, self._lower, self._upper)  # only guards against round-off
-        poses = integrate_twist(state.poses, twist, dt)
+        # Clip the command (forcing vy = 0), clip the previous twist (a hand-made state outside
+        # the limits is brought back at once: velocity limits win), rate-limit, integrate.
+        poses, twist = box_step(state.poses, state.twists, cmd, self._lower, self._upper,
+                                self._acc, dt)
         return KinematicState(poses, twist, np.zeros(len(state)))

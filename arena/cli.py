@@ -1,0 +1,154 @@
+"""The ``arena`` command line: a thin front end on the public API.
+
+Errors that users cause (bad config, unknown names, missing files) print as one line and exit
+with status 2; no traceback. ``ARENA_DEBUG=1`` shows the traceback anyway.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from arena.core.errors import ArenaError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=False,
+    help="Arena: simulate, develop and benchmark social robot navigation.",
+    pretty_exceptions_enable=False,
+)
+console = Console()
+err_console = Console(stderr=True)
+
+
+@app.command()
+def run(
+    config: Annotated[
+        str | None,
+        typer.Argument(
+            help="experiment YAML (default: the packaged demo); or a key=value override"
+        ),
+    ] = None,
+    overrides: Annotated[
+        list[str] | None, typer.Argument(help="dotted overrides, e.g. robot=burger seed=3")
+    ] = None,
+    episodes: Annotated[
+        int | None, typer.Option("--episodes", "-n", help="number of episodes")
+    ] = None,
+    robot: Annotated[str | None, typer.Option(help="robot preset name or YAML path")] = None,
+    map_: Annotated[
+        str | None, typer.Option("--map", help="map.yaml file, world folder or packaged world name")
+    ] = None,
+    seed: Annotated[int | None, typer.Option(help="master seed")] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="output folder")] = None,
+    video: Annotated[bool | None, typer.Option("--video/--no-video", help="write videos")] = None,
+) -> None:
+    """Run episodes: a robot drives to its goals among people; writes videos and trajectories."""
+    from arena.config import load_config
+    from arena.experiment import run_experiment
+
+    items = ([config] if config else []) + list(overrides or [])
+    path = None
+    if items and "=" not in items[0]:
+        path, items = items[0], items[1:]
+    if episodes is not None:
+        items.append(f"episodes={episodes}")
+    if robot is not None:
+        items.append(f"robot={robot}")
+    if seed is not None:
+        items.append(f"seed={seed}")
+    if video is not None:
+        items.append(f"output.video={'true' if video else 'false'}")
+    if map_ is not None:
+        p = Path(map_)
+        if p.suffix in (".yaml", ".yml"):
+            items += ["map.type=file", f"map.path={p.resolve()}"]
+        else:
+            items += ["map.type=world", f"map.name={p.resolve() if p.is_dir() else map_}"]
+    cfg = load_config(path, items)
+
+    table = Table(title=f"arena run · {cfg.name}", show_lines=False)
+    for col in ("episode", "outcome", "time [s]", "path [m]", "collisions", "wall [s]"):
+        table.add_column(col, justify="right")
+    where = cfg.map.get("name") or cfg.map.get("path") or cfg.map["type"]
+    console.print(
+        f"[bold]{cfg.robot}[/] on [bold]{where}[/]"
+        f", {cfg.episodes} episode(s), seed {cfg.seed}, planner "
+        f"{cfg.navigation.global_planner['type']} + {cfg.navigation.local_planner['type']}"
+    )
+
+    def show(res) -> None:
+        colour = {"success": "green", "timeout": "yellow"}.get(res.outcome, "red")
+        console.print(
+            f"  episode {res.index}: [{colour}]{res.outcome}[/] after {res.time:.1f} s, "
+            f"{res.path_length:.1f} m, {res.collisions} collision(s) ({res.wall_time:.1f} s wall)"
+        )
+        table.add_row(
+            str(res.index),
+            res.outcome,
+            f"{res.time:.1f}",
+            f"{res.path_length:.1f}",
+            str(res.collisions),
+            f"{res.wall_time:.1f}",
+        )
+
+    out_dir, results = run_experiment(cfg, out, on_episode=show)
+    console.print(table)
+    console.print(f"results:     {out_dir}/summary.csv")
+    for res in results:
+        for kind in ("video", "trajectory"):
+            if kind in res.files:
+                console.print(f"{kind + ':':12} {res.files[kind]}")
+
+
+@app.command()
+def robots() -> None:
+    """List the robot presets with their kinematics, limits and lidar."""
+    from arena.robots.presets import describe_robots
+
+    rows = describe_robots()
+    table = Table(title="Robot presets")
+    for col in rows[0]:
+        table.add_column(str(col))
+    for row in rows:
+        table.add_row(*(str(v) for v in row.values()))
+    console.print(table)
+
+
+@app.command()
+def plugins() -> None:
+    """List every plugin registry and the names registered in it."""
+    import arena.plugins  # noqa: F401
+    from arena.core.registry import all_registries
+
+    table = Table(title="Plugin registries")
+    table.add_column("kind")
+    table.add_column("name")
+    table.add_column("tags")
+    table.add_column("description")
+    for kind, reg in sorted(all_registries().items()):
+        for i, entry in enumerate(reg.entries()):
+            table.add_row(kind if i == 0 else "", entry.name, ", ".join(entry.tags), entry.summary)
+        table.add_section()
+    console.print(table)
+
+
+def main() -> None:
+    """Console-script entry point: run the app, print user errors as one line."""
+    try:
+        app()
+    except ArenaError as e:
+        if os.environ.get("ARENA_DEBUG"):
+            raise
+        err_console.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+        sys.exit(2)
+
+
+if __name__ == "__main__":
+    main()

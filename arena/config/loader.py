@@ -1,0 +1,205 @@
+"""Load an experiment config from YAML, apply dotted command-line overrides, validate everything.
+
+``arena run my.yaml robot=burger map.type=empty seed=3`` → :func:`load_config` with the file and
+three overrides. Rules:
+
+* The file is merged over the built-in defaults; overrides are merged over that.
+* A plugin block (a mapping with ``type``) whose ``type`` changes is replaced, not merged, so
+  parameters of the old plugin do not leak into the new one.
+* Values are parsed as YAML (``3`` → int, ``[1, 2]`` → list, ``true`` → bool).
+* Unknown keys are errors; every error names the file (or the override) and the key path.
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import ValidationError
+
+from arena.config.schema import ExperimentConfig
+from arena.core.errors import ConfigError, UnknownNameError, from_validation_error
+
+PRESETS_DIR = Path(__file__).resolve().parent / "presets"
+DEFAULT_CONFIG = PRESETS_DIR / "default.yaml"
+_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
+
+
+def read_yaml(path: str | Path) -> dict[str, Any]:
+    """Read a YAML mapping; missing files and malformed YAML raise :class:`ConfigError`."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError("file not found", source=str(p))
+    try:
+        data = yaml.safe_load(p.read_text(encoding="utf-8"))
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
+        raise ConfigError(f"malformed YAML{where}: {problem}", source=str(p)) from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise ConfigError(f"cannot read file: {e}", source=str(p)) from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(
+            f"expected a mapping of keys at the top level, got {type(data).__name__}", source=str(p)
+        )
+    return data
+
+
+def merge(base: dict[str, Any], update: dict[str, Any]) -> dict[str, Any]:
+    """Deep-merge ``update`` into a copy of ``base``; a plugin block changing type is replaced."""
+    out = copy.deepcopy(base)
+    for key, value in update.items():
+        old = out.get(key)
+        if isinstance(old, dict) and isinstance(value, dict):
+            if "type" in value and "type" in old and value["type"] != old["type"]:
+                out[key] = copy.deepcopy(value)
+            else:
+                out[key] = merge(old, value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """Split ``"a.b=value"`` into the key path and the YAML-parsed value."""
+    if "=" not in text:
+        raise ConfigError(
+            f"override {text!r} is not of the form key.path=value", source="command line"
+        )
+    key, _, raw = text.partition("=")
+    key = key.strip()
+    if not _KEY.match(key):
+        raise ConfigError(
+            f"override {text!r}: {key!r} is not a dotted key path", source="command line"
+        )
+    try:
+        value = yaml.safe_load(raw) if raw.strip() else ""
+    except yaml.YAMLError:
+        value = raw  # not YAML: keep the literal string
+    return key, value
+
+
+def _nest(key: str, value: Any) -> dict[str, Any]:
+    out: Any = value
+    for part in reversed(key.split(".")):
+        out = {part: out}
+    return out
+
+
+def load_config(path: str | Path | None = None, overrides: Sequence[str] = ()) -> ExperimentConfig:
+    """Load, merge and validate an experiment config (file + overrides).
+
+    Args:
+        path: a YAML file; ``None`` uses the packaged ``arena/config/presets/default.yaml``.
+        overrides: ``key.path=value`` strings applied in order.
+
+    Raises:
+        ConfigError: with the file (or the override) and the key path of the first problem.
+    """
+    source = str(path) if path is not None else str(DEFAULT_CONFIG)
+    data = merge(ExperimentConfig().model_dump(mode="json"), read_yaml(source))
+    if path is not None:
+        _resolve_relative_paths(data, Path(source).resolve().parent)
+    override_paths: list[tuple[str, str]] = []
+    for text in overrides:
+        key, value = parse_override(text)
+        data = _apply(data, key, value, text)
+        override_paths.append((key, text))
+
+    def located(err: ConfigError) -> ConfigError:
+        # Blame the override that set this key, if one did.
+        for key, text in reversed(override_paths):
+            if not err.path:
+                continue
+            same_block = (
+                key.endswith(".type") and key.rsplit(".", 1)[0] == err.path.rsplit(".", 1)[0]
+            )
+            if (
+                err.path == key
+                or err.path.startswith(key + ".")
+                or key.startswith(err.path + ".")
+                or same_block
+            ):
+                return type(err)(err.message, source=f"override {text!r}", path=err.path)
+        return err
+
+    try:
+        cfg = ExperimentConfig.model_validate(data)
+    except ValidationError as e:
+        raise located(from_validation_error(e, source=source)) from None
+    try:
+        validate_plugins(cfg, source=source)
+    except ConfigError as e:
+        raise located(e) from None
+    return cfg
+
+
+def _apply(data: dict[str, Any], key: str, value: Any, text: str) -> dict[str, Any]:
+    node: Any = data
+    parts = key.split(".")
+    for i, part in enumerate(parts[:-1]):
+        if isinstance(node, dict) and part in node and not isinstance(node[part], dict):
+            raise ConfigError(
+                f"cannot set {key!r}: {'.'.join(parts[: i + 1])!r} is a value, not a block",
+                source=f"override {text!r}",
+                path=key,
+            )
+        node = node.get(part, {}) if isinstance(node, dict) else {}
+    return merge(data, _nest(key, value))
+
+
+def _resolve_relative_paths(data: dict[str, Any], base: Path) -> None:
+    """Make file paths in a config file relative to that file, as users expect."""
+    m = data.get("map")
+    if isinstance(m, dict) and m.get("type") == "file" and isinstance(m.get("path"), str):
+        p = Path(m["path"]).expanduser()
+        if not p.is_absolute() and (base / p).exists():
+            m["path"] = str(base / p)
+    robot = data.get("robot")
+    if isinstance(robot, str) and robot.endswith((".yaml", ".yml")):
+        p = Path(robot).expanduser()
+        if not p.is_absolute() and (base / p).exists():
+            data["robot"] = str(base / p)
+
+
+def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> None:
+    """Check every plugin block and the robot against their registries."""
+    import arena.plugins  # noqa: F401  (fills the registries)
+    from arena.crowd.base import CROWD_MODELS
+    from arena.maps.sources import MAP_SOURCES
+    from arena.nav.global_planners.base import GLOBAL_PLANNERS
+    from arena.nav.local_planners.base import LOCAL_PLANNERS
+    from arena.robots.presets import load_robot
+    from arena.sim.backend import BACKENDS
+    from arena.tasks.base import TASKS
+
+    MAP_SOURCES.validate(cfg.map, source=source, path="map")
+    TASKS.validate(cfg.task, source=source, path="task")
+    CROWD_MODELS.validate(cfg.crowd, source=source, path="crowd")
+    BACKENDS.validate(cfg.sim.backend, source=source, path="sim.backend")
+    GLOBAL_PLANNERS.validate(
+        cfg.navigation.global_planner, source=source, path="navigation.global_planner"
+    )
+    local, _ = LOCAL_PLANNERS.validate(
+        cfg.navigation.local_planner, source=source, path="navigation.local_planner"
+    )
+    try:
+        robot = load_robot(cfg.robot)
+    except UnknownNameError as e:
+        raise UnknownNameError(e.message, source=source, path="robot") from None
+    kind = robot.kinematics_type
+    supported = getattr(local.obj, "supports", frozenset())
+    if kind not in supported:
+        raise ConfigError(
+            f"local planner {local.name!r} cannot drive {kind!r} robots like {robot.name!r} "
+            f"(it supports: {', '.join(sorted(supported))})",
+            source=source,
+            path="navigation.local_planner.type",
+        )

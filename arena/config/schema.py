@@ -1,0 +1,61 @@
+"""The experiment config: one pydantic model for everything ``arena run`` needs.
+
+Polymorphic blocks (``map``, ``task``, ``crowd``, ``navigation.*_planner``, ``sim.backend``)
+are flat mappings ``{type: name, **params}``; :func:`arena.config.loader.validate_plugins`
+checks each against its registry so that every error names the file and the key path.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from arena.nav.stack import NavigationConfig
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class SimConfig(_Strict):
+    """Simulation settings."""
+
+    backend: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "native2d"}, description="{type: backend name, ...params}"
+    )
+    dt: float = Field(0.1, gt=0, le=1.0, description="s, simulation and control period")
+
+
+class OutputConfig(_Strict):
+    """Where and what to write."""
+
+    dir: Path | None = Field(None, description="output folder; default runs/<timestamp>")
+    video: bool = Field(True, description="write a video per episode")
+    video_format: Literal["mp4", "gif"] = "mp4"
+    video_episodes: int = Field(3, ge=0, description="write videos for the first N episodes only")
+    frame_every: int = Field(1, ge=1, description="render every N-th simulation step")
+    width_px: int = Field(800, ge=200, le=4000, description="video frame width")
+
+
+class ExperimentConfig(_Strict):
+    """One experiment: a robot, a map, a task, a crowd, a navigation stack, a simulator."""
+
+    name: str = Field("default", description="label for outputs")
+    seed: int = Field(0, ge=0, description="master seed: every random draw derives from it")
+    episodes: int = Field(1, ge=1, description="number of episodes")
+    robot: str = Field("jackal", description="robot preset name or path to a robot YAML")
+    map: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "world", "name": "small_office"},
+        description="{type: map source, ...params}",
+    )
+    task: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "random"}, description="{type: task, ...params}"
+    )
+    crowd: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "waypoint_walker"}, description="{type: crowd model, ...}"
+    )
+    navigation: NavigationConfig = Field(default_factory=NavigationConfig)
+    sim: SimConfig = Field(default_factory=SimConfig)
+    output: OutputConfig = Field(default_factory=OutputConfig)

@@ -1,0 +1,393 @@
+"""Run an experiment: sample episodes, simulate them with the navigation stack, write results.
+
+This is what ``arena run`` calls. One config + seed gives the same episodes, trajectories and
+outcomes on every machine: every random draw comes from a generator derived from
+``(seed, "episode", index, <component>)``.
+
+Output layout (``output.dir``)::
+
+    config.yaml             the resolved config
+    summary.csv             one row per episode
+    episode_000/
+        trajectory.csv      robot state per step
+        agents.csv          pedestrian state per step
+        episode.json        start, goal, outcome, figures
+        video.mp4           top-down video (first ``output.video_episodes`` episodes)
+        final.png           the last frame
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from datetime import datetime
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+import arena.plugins  # noqa: F401  (fills the registries)
+from arena.config.schema import ExperimentConfig
+from arena.core.errors import ArenaError, PlanningError
+from arena.core.rng import derive_rng
+from arena.core.types import Outcome
+from arena.crowd.base import CROWD_MODELS
+from arena.maps.raster import polygon_mask
+from arena.maps.sources import MAP_SOURCES, MapSource
+from arena.nav.local_planners.base import LocalObservation
+from arena.nav.stack import NavigationStack
+from arena.robots.model import RobotModel
+from arena.robots.presets import load_robot
+from arena.sim.backend import BACKENDS, SimulatorBackend
+from arena.sim.state import SimState
+from arena.tasks.base import TASKS, Task
+from arena.tasks.episode import Episode
+
+
+@dataclass
+class EpisodeResult:
+    """Figures of one finished episode (robot 0)."""
+
+    index: int
+    seed: int
+    map: str
+    robot: str
+    outcome: str
+    time: float
+    steps: int
+    path_length: float
+    collisions: int
+    start: list[float]
+    goal: list[float]
+    final_goal_distance: float
+    wall_time: float
+    error: str = ""
+    files: dict[str, str] = field(default_factory=dict)
+
+
+def make_episode(
+    cfg: ExperimentConfig,
+    index: int,
+    robot: RobotModel | None = None,
+    *,
+    source: MapSource | None = None,
+    task: Task | None = None,
+) -> Episode:
+    """Episode ``index`` of the experiment, drawn deterministically from ``cfg.seed``.
+
+    ``robot``, ``source`` and ``task`` may be passed in to reuse them across episodes (a file
+    map is then read once); they are built from ``cfg`` otherwise.
+    """
+    robot = robot or load_robot(cfg.robot)
+    source = source or MAP_SOURCES.build(cfg.map, path="map")
+    map_result = source.build(derive_rng(cfg.seed, "episode", index, "map"))
+    task = task or TASKS.build(cfg.task, path="task")
+    return task.sample(
+        map_result,
+        [robot],
+        index=index,
+        seed=cfg.seed,
+        rng=derive_rng(cfg.seed, "episode", index, "task"),
+    )
+
+
+def planning_grid(episode: Episode):
+    """The map with the known static obstacles burnt in: what the global planner plans on."""
+    if not episode.obstacles:
+        return episode.grid
+    return episode.grid.with_occupied(
+        polygon_mask(episode.grid, [o.polygon for o in episode.obstacles])
+    )
+
+
+class EpisodeRecorder:
+    """Collects per-step robot and pedestrian state and writes them as CSV."""
+
+    ROBOT_COLUMNS = (
+        "step",
+        "time",
+        "x",
+        "y",
+        "theta",
+        "vx",
+        "vy",
+        "omega",
+        "cmd_vx",
+        "cmd_vy",
+        "cmd_omega",
+        "min_range",
+        "collision",
+    )
+    AGENT_COLUMNS = (
+        "step",
+        "time",
+        "id",
+        "x",
+        "y",
+        "vx",
+        "vy",
+        "heading",
+        "radius",
+        "kind",
+        "state",
+    )
+
+    def __init__(self) -> None:
+        self.robot_rows: list[np.ndarray] = []
+        self.agent_rows: list[np.ndarray] = []
+
+    def record(self, s: SimState) -> None:
+        """Store robot 0 and every pedestrian at this snapshot."""
+        r = s.robots
+        scan = r.scans[0]
+        min_range = float(scan.min()) if scan.size else math.nan
+        self.robot_rows.append(
+            np.concatenate(
+                [
+                    [s.step, s.time],
+                    r.poses[0],
+                    r.twists[0],
+                    r.commands[0],
+                    [min_range, float(s.collisions.any[0])],
+                ]
+            )
+        )
+        a = s.agents
+        n = len(a)
+        if n:
+            self.agent_rows.append(
+                np.column_stack(
+                    [
+                        np.full(n, s.step),
+                        np.full(n, s.time),
+                        a.ids,
+                        a.positions,
+                        a.velocities,
+                        a.headings,
+                        a.radii,
+                        a.kinds,
+                        a.states,
+                    ]
+                )
+            )
+
+    @property
+    def poses(self) -> np.ndarray:
+        """``(steps, 3)`` robot poses."""
+        return np.array([row[2:5] for row in self.robot_rows])
+
+    def write(self, folder: Path) -> dict[str, str]:
+        """Write ``trajectory.csv`` and ``agents.csv``; return their paths."""
+        traj = folder / "trajectory.csv"
+        _write_csv(traj, self.ROBOT_COLUMNS, np.array(self.robot_rows), int_cols=(0, 12))
+        agents = folder / "agents.csv"
+        rows = np.concatenate(self.agent_rows) if self.agent_rows else np.zeros((0, 11))
+        _write_csv(agents, self.AGENT_COLUMNS, rows, int_cols=(0, 2, 9, 10))
+        return {"trajectory": str(traj), "agents": str(agents)}
+
+
+def _write_csv(
+    path: Path, header: tuple[str, ...], rows: np.ndarray, int_cols: tuple[int, ...]
+) -> None:
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        for row in rows:
+            w.writerow([int(v) if i in int_cols else f"{v:.6g}" for i, v in enumerate(row)])
+
+
+def run_episode(
+    cfg: ExperimentConfig,
+    episode: Episode,
+    backend: SimulatorBackend,
+    out_dir: Path | None,
+    *,
+    video: bool = False,
+) -> EpisodeResult:
+    """Simulate one episode with the configured navigation stack and write its files."""
+    t0 = time.perf_counter()
+    spawn = episode.robots[0]
+    robot = spawn.model
+    seed, idx = cfg.seed, episode.index
+    crowd = CROWD_MODELS.build(cfg.crowd, path="crowd")
+    state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
+    stack = NavigationStack.from_config(cfg.navigation, robot_radius=robot.radius)
+    limits = robot.limits()
+    laser = robot.laser
+    angles = laser.angles() + laser.mount[2]
+    scan_origin = np.array(laser.mount[:2])
+    dt = cfg.sim.dt
+    goal = spawn.goal
+    goal_radius = episode.goal_radius
+
+    recorder = EpisodeRecorder()
+    recorder.record(state)
+    states = [state] if video else []
+    outcome, error = Outcome.TIMEOUT, ""
+    collisions, touching = 0, False
+    try:
+        stack.reset(planning_grid(episode), spawn.start, goal)
+        while True:
+            pose = state.robots.poses[0]
+            if math.hypot(goal.x - pose[0], goal.y - pose[1]) < goal_radius:
+                outcome = Outcome.SUCCESS
+                break
+            if state.time >= episode.time_limit - 1e-9:
+                outcome = Outcome.TIMEOUT
+                break
+            obs = LocalObservation(
+                pose=pose,
+                twist=state.robots.twists[0],
+                goal=goal,
+                path=stack.path,
+                limits=limits,
+                robot_radius=robot.radius,
+                dt=dt,
+                scan_ranges=state.robots.scans[0],
+                scan_angles=angles,
+                scan_origin=scan_origin,
+                time=state.time,
+                kinematics=robot.kinematics_type,
+            )
+            cmd = np.asarray(stack.step(obs), dtype=np.float64)
+            if cmd.shape != (3,) or not np.all(np.isfinite(cmd)):
+                raise ArenaError(f"the navigation stack returned an invalid command {cmd!r}")
+            state = backend.step(cmd[None, :], dt)
+            recorder.record(state)
+            if video:
+                states.append(state)
+            hit = bool(state.collisions.any[0])
+            collisions += hit and not touching  # count contact events, not contact steps
+            touching = hit
+    except PlanningError as e:
+        outcome, error = Outcome.PLANNER_FAILURE, f"{type(e).__name__}: {e}"
+    except ArenaError as e:
+        outcome, error = Outcome.ERROR, f"{type(e).__name__}: {e}"
+
+    poses = recorder.poses
+    path_length = (
+        float(np.sum(np.hypot(*np.diff(poses[:, :2], axis=0).T))) if len(poses) > 1 else 0.0
+    )
+    final = poses[-1]
+    result = EpisodeResult(
+        index=idx,
+        seed=seed,
+        map=episode.map_name,
+        robot=robot.name,
+        outcome=outcome.value,
+        time=round(state.time, 6),
+        steps=state.step,
+        path_length=path_length,
+        collisions=collisions,
+        start=spawn.start.as_array().tolist(),
+        goal=goal.as_array().tolist(),
+        final_goal_distance=float(math.hypot(goal.x - final[0], goal.y - final[1])),
+        wall_time=0.0,
+        error=error,
+    )
+    if out_dir is not None:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        result.files.update(recorder.write(out_dir))
+        if video and states:
+            result.files.update(
+                _write_video(cfg, backend, states, stack.path, goal, out_dir, outcome)
+            )
+        result.wall_time = time.perf_counter() - t0
+        (out_dir / "episode.json").write_text(json.dumps(asdict(result), indent=2))
+    result.wall_time = time.perf_counter() - t0
+    return result
+
+
+def _write_video(
+    cfg, backend, states, path, goal, out_dir: Path, outcome: Outcome
+) -> dict[str, str]:
+    # Imported here: rendering is optional and the only user of matplotlib.
+    from arena.render import FrameRenderer, Overlay, VideoWriter, save_png
+
+    robot_specs = [load_robot(cfg.robot).laser]
+    renderer = FrameRenderer(
+        backend.world,
+        lidar_specs=robot_specs,
+        width_px=cfg.output.width_px,
+        title=f"{cfg.name} · {states[0].robots.models[0]}",
+    )
+    video_path = out_dir / f"video.{cfg.output.video_format}"
+    goals = goal.as_array()[None, :]
+    fps = 1.0 / cfg.sim.dt / cfg.output.frame_every
+    frame = None
+    with VideoWriter(video_path, fps=fps) as writer:
+        for k, s in enumerate(states):
+            last = k == len(states) - 1
+            if k % cfg.output.frame_every and not last:
+                continue
+            text = f"t = {s.time:5.1f} s   step {s.step}"
+            if last:
+                text += f"   {outcome.value}"
+            frame = renderer.render(s, Overlay(paths=[path], goals=goals, text=text))
+            writer.append(frame)
+    files = {"video": str(video_path)}
+    if frame is not None:
+        png = out_dir / "final.png"
+        save_png(frame, png)
+        files["final_frame"] = str(png)
+    return files
+
+
+def default_output_dir(cfg: ExperimentConfig) -> Path:
+    """``runs/<name>_<YYYYmmdd-HHMMSS>``."""
+    return Path("runs") / f"{cfg.name}_{datetime.now().strftime('%Y%m%d-%H%M%S')}"
+
+
+def run_experiment(
+    cfg: ExperimentConfig,
+    out_dir: Path | None = None,
+    *,
+    on_episode: Callable[[EpisodeResult], None] | None = None,
+) -> tuple[Path, list[EpisodeResult]]:
+    """Run every episode of ``cfg`` and write the outputs under ``out_dir``."""
+    robot = load_robot(cfg.robot)
+    backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
+    source = MAP_SOURCES.build(cfg.map, path="map")
+    task = TASKS.build(cfg.task, path="task")
+    # Draw the first episode before writing anything: a bad map or task fails with no output.
+    first = make_episode(cfg, 0, robot, source=source, task=task)
+    out = Path(out_dir or cfg.output.dir or default_output_dir(cfg))
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "config.yaml").write_text(yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False))
+    results = []
+    for i in range(cfg.episodes):
+        episode = first if i == 0 else make_episode(cfg, i, robot, source=source, task=task)
+        video = cfg.output.video and i < cfg.output.video_episodes
+        res = run_episode(cfg, episode, backend, out / f"episode_{i:03d}", video=video)
+        results.append(res)
+        if on_episode:
+            on_episode(res)
+    _write_summary(out / "summary.csv", results)
+    return out, results
+
+
+def _write_summary(path: Path, results: list[EpisodeResult]) -> None:
+    cols = [
+        "index",
+        "seed",
+        "map",
+        "robot",
+        "outcome",
+        "time",
+        "steps",
+        "path_length",
+        "collisions",
+        "final_goal_distance",
+        "wall_time",
+        "error",
+    ]
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(cols)
+        for r in results:
+            d = asdict(r)
+            w.writerow([f"{d[c]:.4f}" if isinstance(d[c], float) else d[c] for c in cols])

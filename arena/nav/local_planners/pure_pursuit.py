@@ -1,0 +1,413 @@
+"""Pure pursuit: steer toward a point one lookahead distance ahead on the global path.
+
+Description:
+    Each tick the robot is projected onto the path (the projection only moves forward along a
+    given path, so a path that doubles back on itself is followed in order), and the point one
+    lookahead distance ``L = lookahead + lookahead_gain · |v|`` further along the path is chased:
+
+    - ``diff_drive`` / ``legged``: the arc through the lookahead point, curvature
+      ``κ = 2·y / (x² + y²)`` with ``(x, y)`` the point in the robot frame. If the heading error
+      exceeds ``rotate_threshold`` and the robot can turn on the spot (``min_turning_radius == 0``)
+      it first rotates in place, until the error falls below half the threshold (hysteresis).
+    - ``ackermann``: the same arc with ``|κ| ≤ 1 / min_turning_radius``; no reversing, no turning
+      on the spot (a point behind gets the tightest turn toward its side). ``omega = κ · vx``
+      exactly, so the turning-radius bound holds every tick (see ``LocalPlanner.compute``).
+    - ``omni``: a straight velocity toward the lookahead point, scaled into the ``vx``/``vy``
+      box, while ``omega`` turns the heading toward the direction of travel.
+
+Speed profile:
+    The forward speed is the smallest of ``max_speed`` (or ``vx_max``), ``omega_max / |κ|``, the
+    braking speed ``sqrt(2 · decel · d_goal)`` with ``decel = decel_fraction · acc_x`` (so it
+    stops at the goal) and the obstacle speed below; then it is moved at most ``acc · dt`` from
+    the current twist. Within ``goal_tolerance`` of the path end the command is zero (braking
+    within the acceleration limits).
+
+Obstacle check:
+    Laser returns are tested against the corridor the robot sweeps along its direction of motion
+    (the arc of curvature ``κ``, or the straight line for omni motion). For each corridor width —
+    the robot's own radius, and the radius plus ``safety_margin`` — the free gap ``s`` is the
+    distance the disc can move before touching the nearest return ahead. The speed is scaled by
+    ``(s - stop_distance) / (slow_distance - stop_distance)`` clipped to ``[0, 1]`` and capped by
+    the speed from which the robot can still brake before ``stop_distance``; when the robot's own
+    gap is ``≤ stop_distance`` it stops. A return that lies only in the margin band (it would
+    pass beside the robot) slows it to ``creep_fraction`` of the speed at most, never to a stop:
+    walls of a passage narrower than the margin must not stall the robot.
+
+    If the nominal lookahead's arc is blocked, halved lookaheads down to ``min_lookahead`` are
+    tried and the longest one allowing the highest speed is used: a long arc cuts corners, a short
+    one follows the (collision-free) path closely. A robot that is blocked anyway and can turn on
+    the spot keeps turning toward its lookahead point, so it waits for a pedestrian straight
+    ahead but frees itself from a wall it approached at an angle.
+
+Limitations:
+    It never reverses, so a car-like robot that ends up facing a wall stays there; returns are
+    not tracked, so a moving pedestrian is treated like a wall at its current position. Later
+    local planners (DWA, TEB, MPC) handle both.
+
+Goal heading:
+    Optional. With ``align_goal_heading`` a robot that can turn on the spot rotates to the goal's
+    ``theta`` once within ``goal_tolerance``; otherwise the final heading is whatever the approach
+    left (Ackermann robots never align).
+
+Arguments:
+    See :class:`PurePursuitPlanner.Params`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+from arena.core.types import wrap_angle_scalar
+from arena.nav.local_planners.base import (
+    KINEMATICS,
+    LOCAL_PLANNERS,
+    LocalObservation,
+    limit_command,
+    stopping_speed,
+)
+
+# Below this |curvature| (1/m) an arc is treated as a straight line (radius > 1 km).
+_STRAIGHT = 1e-3
+
+
+@LOCAL_PLANNERS.register("pure_pursuit", tags=("default", "classic"))
+class PurePursuitPlanner:
+    """Pure pursuit path follower with a goal-braking speed profile and a laser safety corridor.
+
+    Args:
+        params: validated :class:`PurePursuitPlanner.Params` (defaults if omitted).
+    """
+
+    supports: ClassVar[frozenset[str]] = KINEMATICS
+
+    class Params(BaseModel):
+        """Parameters of :class:`PurePursuitPlanner`."""
+
+        model_config = ConfigDict(frozen=True, extra="forbid")
+
+        lookahead: float = Field(0.6, gt=0, description="m, lookahead distance at standstill")
+        lookahead_gain: float = Field(
+            0.5, ge=0, description="s, lookahead grows by this times the current speed"
+        )
+        max_lookahead: float = Field(1.5, gt=0, description="m, cap on the speed-scaled lookahead")
+        max_speed: float | None = Field(
+            None, gt=0, description="m/s, cruise speed; None uses the robot's vx_max"
+        )
+        rotate_threshold: float = Field(
+            0.8, gt=0, le=math.pi,
+            description="rad, heading error above which robots that can turn on the spot do so",
+        )
+        heading_gain: float = Field(
+            2.0, gt=0, description="1/s, proportional gain of in-place and omni heading control"
+        )
+        goal_tolerance: float = Field(
+            0.05, gt=0, description="m, distance to the path end at which the planner stops"
+        )
+        decel_fraction: float = Field(
+            0.8, gt=0, le=1,
+            description="share of acc_x used for planned braking (headroom for discrete ticks)",
+        )
+        safety_margin: float = Field(
+            0.05, ge=0, description="m, added to the robot radius for the corridor half-width"
+        )
+        stop_distance: float = Field(
+            0.15, ge=0, description="m, free gap to a laser return at which the robot stops"
+        )
+        slow_distance: float = Field(
+            1.0, gt=0, description="m, free gap below which the robot starts slowing down"
+        )
+        creep_fraction: float = Field(
+            0.2, ge=0, le=1,
+            description="share of the speed kept when a return lies only in the safety margin",
+        )
+        min_lookahead: float = Field(
+            0.15, gt=0, description="m, shortest lookahead tried when longer arcs are blocked"
+        )
+        align_goal_heading: bool = Field(
+            False, description="turn on the spot to the goal's theta once at the goal"
+        )
+        goal_yaw_tolerance: float = Field(
+            0.05, gt=0, description="rad, heading error accepted when aligning at the goal"
+        )
+
+        @model_validator(mode="after")
+        def _check(self) -> PurePursuitPlanner.Params:
+            if self.slow_distance <= self.stop_distance:
+                raise ValueError(
+                    f"slow_distance ({self.slow_distance}) must exceed stop_distance "
+                    f"({self.stop_distance})"
+                )
+            if self.min_lookahead > self.lookahead:
+                raise ValueError(
+                    f"min_lookahead ({self.min_lookahead}) must be <= lookahead ({self.lookahead})"
+                )
+            if self.max_lookahead < self.lookahead:
+                raise ValueError(
+                    f"max_lookahead ({self.max_lookahead}) must be >= lookahead ({self.lookahead})"
+                )
+            return self
+
+    def __init__(self, params: Params | None = None) -> None:
+        self.params = params if params is not None else self.Params()
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the tracked path, the progress along it and the rotate-in-place latch."""
+        self._path: NDArray[np.float64] | None = None
+        self._cum = np.zeros(1)
+        self._seg = 0
+        self._rotating = False
+
+    # -- path tracking ----------------------------------------------------------------------------
+    def _track(self, path: NDArray[np.float64], xy: NDArray[np.float64]) -> tuple[float, float]:
+        """Project ``xy`` on the path; return ``(arc length of the projection, path length)``."""
+        if self._path is None or self._path.shape != path.shape or not np.array_equal(
+            self._path, path
+        ):
+            self._path = path.copy()
+            seg_len = np.linalg.norm(np.diff(path, axis=0), axis=1)
+            self._cum = np.concatenate([[0.0], np.cumsum(seg_len)])
+            self._seg = 0
+        cum = self._cum
+        n_seg = len(path) - 1
+        # Search a window ahead of the last projection only: progress never jumps back, and a
+        # path passing near itself later is not short-cut.
+        horizon = cum[self._seg] + self.params.max_lookahead + 2.0
+        i1 = int(np.searchsorted(cum, horizon, side="right"))
+        i1 = min(max(i1, self._seg + 1), n_seg)
+        a = path[self._seg:i1]
+        ab = path[self._seg + 1:i1 + 1] - a
+        len2 = np.einsum("ij,ij->i", ab, ab)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.einsum("ij,ij->i", xy - a, ab) / len2
+        t = np.clip(np.nan_to_num(t, nan=0.0, posinf=0.0, neginf=0.0), 0.0, 1.0)
+        d = np.linalg.norm(a + t[:, None] * ab - xy, axis=1)
+        j = int(np.argmin(d))
+        self._seg += j
+        s = cum[self._seg] + t[j] * math.sqrt(len2[j])
+        return float(s), float(cum[-1])
+
+    def _point_at(self, s: float) -> NDArray[np.float64]:
+        """Return the path point at arc length ``s`` (clamped to the path)."""
+        assert self._path is not None
+        cum, path = self._cum, self._path
+        if s >= cum[-1]:
+            return path[-1].copy()
+        i = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(path) - 2))
+        seg = cum[i + 1] - cum[i]
+        t = 0.0 if seg <= 0 else (s - cum[i]) / seg
+        return path[i] + t * (path[i + 1] - path[i])
+
+    # -- obstacle corridor -----------------------------------------------------------------------
+    def _free_gaps(
+        self, points: NDArray[np.float64], heading: NDArray[np.float64], curvature: float,
+        robot_radius: float,
+    ) -> tuple[float, float]:
+        """Distances (m) the robot can travel along its motion before a return enters its corridor.
+
+        Args:
+            points: ``(m, 2)`` laser returns in the robot frame.
+            heading: ``(2,)`` unit direction of straight motion in the robot frame (used when
+                ``curvature`` is ~0).
+            curvature: signed curvature of forward motion (1/m, CCW positive).
+            robot_radius: robot radius (m).
+
+        Returns:
+            ``(gap of the robot's own disc, gap of the disc grown by safety_margin)``; ``inf``
+            when nothing lies ahead in that corridor.
+        """
+        if len(points) == 0:
+            return math.inf, math.inf
+        if abs(curvature) < _STRAIGHT:
+            along = points @ heading
+            lateral = np.abs(points[:, 0] * heading[1] - points[:, 1] * heading[0])
+        else:
+            # Arc of radius rk about (0, rk): lateral offset from the arc, distance along it.
+            rk = 1.0 / curvature
+            rel = points - np.array([0.0, rk])
+            lateral = np.abs(np.hypot(rel[:, 0], rel[:, 1]) - abs(rk))
+            # Angle swept from the robot (at -rk·ŷ from the centre) to the point, in the turn sense.
+            r0 = np.array([0.0, -rk])
+            cross = r0[0] * rel[:, 1] - r0[1] * rel[:, 0]
+            phi = np.arctan2(cross, rel @ r0) * math.copysign(1.0, curvature)
+            along = phi * abs(rk)
+        # Returns inside the robot's own disc already block it, unless they are behind.
+        if np.any((np.hypot(points[:, 0], points[:, 1]) < robot_radius) & (along >= 0)):
+            return 0.0, 0.0
+        gaps = []
+        for half in (robot_radius, robot_radius + self.params.safety_margin):
+            ahead = (along > 0) & (lateral < half)
+            if not np.any(ahead):
+                gaps.append(math.inf)
+                continue
+            # The disc's front reaches a point at lateral offset l after along - sqrt(half² - l²).
+            gap = along[ahead] - np.sqrt(np.maximum(half * half - lateral[ahead] ** 2, 0.0))
+            gaps.append(float(max(np.min(gap), 0.0)))
+        return gaps[0], gaps[1]
+
+    def _obstacle_speed(self, gaps: tuple[float, float], v_ref: float, decel: float) -> float:
+        """Speed (m/s) allowed by the returns ahead, given :meth:`_free_gaps`' two gaps."""
+        p = self.params
+        gap_robot, gap_margin = gaps
+        if gap_robot <= p.stop_distance:
+            return 0.0
+        span = p.slow_distance - p.stop_distance
+        ramp_robot = min((gap_robot - p.stop_distance) / span, 1.0)
+        ramp_margin = min(max((gap_margin - p.stop_distance) / span, 0.0), 1.0)
+        # A return only inside the margin band (it would not touch the robot itself) slows the
+        # robot down to a creep but never stops it: otherwise a wall along a narrow passage,
+        # closer than the margin, would stall the robot for good.
+        factor = min(ramp_robot, max(ramp_margin, p.creep_fraction))
+        return min(v_ref * factor, stopping_speed(gap_robot - p.stop_distance, decel))
+
+    def _lookaheads(self, speed: float) -> list[float]:
+        """Lookahead distances to try, longest first: the nominal one, then halved."""
+        p = self.params
+        look = min(p.lookahead + p.lookahead_gain * speed, p.max_lookahead)
+        out = [look]
+        while out[-1] > p.min_lookahead:
+            out.append(max(out[-1] / 2.0, p.min_lookahead))
+        return out
+
+    # -- control ----------------------------------------------------------------------------------
+    def compute(self, obs: LocalObservation) -> NDArray[np.float64]:
+        """Command ``(3,)`` ``[vx, vy, omega]`` for this tick; see the module docstring."""
+        p = self.params
+        lim = obs.limits
+        dt = float(obs.dt)
+        pose = np.asarray(obs.pose, dtype=np.float64).reshape(3)
+        twist = np.asarray(obs.twist, dtype=np.float64).reshape(3)
+        path = np.asarray(obs.path, dtype=np.float64).reshape(-1, 2)
+        if len(path) == 0:
+            path = obs.goal_pose.xy[None, :]
+        if len(path) == 1:
+            path = np.vstack([path, path])
+        xy = pose[:2]
+        theta = float(pose[2])
+        drive = obs.drive
+        can_spin = lim.min_turning_radius <= 0 and drive != "ackermann"
+
+        s, total = self._track(path, xy)
+        end = path[-1]
+        d_end = float(np.hypot(*(end - xy)))
+        if d_end <= p.goal_tolerance:
+            self._rotating = False
+            cmd = np.zeros(3)
+            if p.align_goal_heading and can_spin:
+                err = wrap_angle_scalar(obs.goal_pose.theta - theta)
+                if abs(err) > p.goal_yaw_tolerance:
+                    cmd[2] = p.heading_gain * err
+            return limit_command(cmd, twist, lim, dt)
+
+        d_goal = max(total - s, d_end)
+        decel = p.decel_fraction * lim.acc_x
+        v_ref = min(lim.vx_max, p.max_speed) if p.max_speed is not None else lim.vx_max
+        v_ref = min(v_ref, stopping_speed(d_goal, decel))
+        points = obs.scan_points()
+        c, sn = math.cos(theta), math.sin(theta)
+        omni = drive == "omni"
+        k_max = 1.0 / lim.min_turning_radius if lim.min_turning_radius > 0 else math.inf
+
+        # Try the nominal lookahead, then shorter ones: where the long arc (or line) would cut a
+        # corner into a laser return, a shorter one follows the collision-free path more closely.
+        # Keep the longest lookahead among those that allow the highest speed.
+        best: tuple[float, float, float, float, tuple[float, float]] | None = None
+        for look in self._lookaheads(float(np.hypot(twist[0], twist[1]))):
+            dx, dy = self._point_at(s + look) - xy
+            tx, ty = c * dx + sn * dy, -sn * dx + c * dy  # lookahead point in the robot frame
+            if tx == 0.0 and ty == 0.0:
+                tx = 1e-9  # degenerate: the target is the robot itself
+            if omni:
+                kappa = 0.0
+                heading = np.array([tx, ty]) / math.hypot(tx, ty)
+            else:
+                kappa = 2.0 * ty / (tx * tx + ty * ty)
+                if k_max < math.inf:
+                    if tx < 0:  # target behind: tightest turn toward its side (no reversing)
+                        kappa = math.copysign(k_max, ty if ty != 0 else 1.0)
+                    kappa = float(np.clip(kappa, -k_max, k_max))
+                heading = np.array([1.0, 0.0])
+            gaps = self._free_gaps(points, heading, kappa, obs.robot_radius)
+            allowed = self._obstacle_speed(gaps, v_ref, decel)
+            if best is None or allowed > best[0] + 1e-9:
+                best = (allowed, tx, ty, kappa, gaps)
+            if allowed >= v_ref - 1e-9:
+                break  # nothing faster to find
+        assert best is not None
+        _, tx, ty, kappa, gaps = best
+
+        if omni:
+            return self._omni(obs, twist, (tx, ty), v_ref, decel, gaps)
+
+        alpha = math.atan2(ty, tx)
+        if can_spin:
+            if abs(alpha) > p.rotate_threshold:
+                self._rotating = True
+            elif abs(alpha) < 0.5 * p.rotate_threshold:
+                self._rotating = False
+        else:
+            self._rotating = False
+        if self._rotating:
+            return limit_command(np.array([0.0, 0.0, p.heading_gain * alpha]), twist, lim, dt)
+
+        v_cap = v_ref if kappa == 0 else min(v_ref, lim.omega_max / abs(kappa))
+        v_des = self._obstacle_speed(gaps, v_cap, decel)
+        v_lo, v_hi = twist[0] - lim.acc_x * dt, twist[0] + lim.acc_x * dt
+        v = float(np.clip(np.clip(v_des, v_lo, v_hi), lim.vx_min, lim.vx_max))
+        if not can_spin:
+            # Car-like: the yaw rate is speed × curvature and follows the speed at once (the real
+            # rate limit is the steering rate, which VelocityLimits does not carry), so keep the
+            # curvature bound exact instead of rate-limiting omega.
+            w = float(np.clip(kappa * v, -lim.omega_max, lim.omega_max))
+            return lim.clip(np.array([v, 0.0, w]))
+        w_lo, w_hi = twist[2] - lim.acc_omega * dt, twist[2] + lim.acc_omega * dt
+        w = float(np.clip(np.clip(kappa * v, w_lo, w_hi), -lim.omega_max, lim.omega_max))
+        if abs(kappa) >= _STRAIGHT and abs(w) < abs(kappa * v):
+            # The yaw rate lagged: slow down (as far as braking allows) to keep the curvature.
+            v = float(np.clip(max(abs(w / kappa), v_lo), lim.vx_min, lim.vx_max))
+        if v_des == 0.0 and gaps[0] <= p.stop_distance:
+            # Blocked: keep turning toward the path (a return dead ahead leaves alpha ≈ 0: wait).
+            w = p.heading_gain * alpha
+        return limit_command(np.array([v, 0.0, w]), twist, lim, dt)
+
+    def _omni(
+        self,
+        obs: LocalObservation,
+        twist: NDArray[np.float64],
+        target: tuple[float, float],
+        v_ref: float,
+        decel: float,
+        gaps: tuple[float, float],
+    ) -> NDArray[np.float64]:
+        """Holonomic motion straight at the lookahead point; heading follows the motion."""
+        p = self.params
+        lim = obs.limits
+        dt = float(obs.dt)
+        tx, ty = target
+        u = np.array([tx, ty]) / math.hypot(tx, ty)
+        # Largest speed along u inside the vx/vy box.
+        bounds = []
+        for comp, lo, hi in ((u[0], lim.vx_min, lim.vx_max), (u[1], lim.vy_min, lim.vy_max)):
+            if comp > 1e-12:
+                bounds.append(hi / comp)
+            elif comp < -1e-12:
+                bounds.append(lo / comp)
+        v_box = max(min(bounds), 0.0) if bounds else 0.0
+        speed = self._obstacle_speed(gaps, min(v_ref, v_box), decel)
+        want = speed * u
+        # Scale the velocity change as a whole so acceleration limits keep the direction of change.
+        dv = want - twist[:2]
+        room = np.array([lim.acc_x, lim.acc_y]) * dt
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratios = np.where(np.abs(dv) > 1e-12, room / np.abs(dv), np.inf)
+        scale = min(1.0, float(np.min(ratios)))
+        vxy = twist[:2] + scale * dv
+        # Turning on the spot is always safe for the disc model, and it lets a robot that cannot
+        # move backwards (vx_min = 0) face a target behind it.
+        w = p.heading_gain * math.atan2(ty, tx)
+        return limit_command(np.array([vxy[0], vxy[1], w]), twist, lim, dt)

@@ -1,0 +1,398 @@
+"""The navigation pipeline: a global planner feeding a local planner.
+
+Data flow per episode: :meth:`NavigationStack.reset` inflates the static map once by
+``robot_radius + inflation_margin`` and plans a global path; every control tick
+:meth:`NavigationStack.step` checks the goal, replans when due, and asks the local planner for a
+body-frame command. A later layer (costmaps, intermediate planners) slots in between without
+changing this interface.
+
+Policies (documented here because tasks and metrics depend on them):
+
+- **Start inside the inflated zone.** A robot that got closer to a wall than the inflation radius
+  has its own cell occupied in the inflated map. Rather than failing, the stack plans from the
+  nearest free cell of the inflated map and prepends the robot's position, provided the straight
+  segment from the robot to that cell crosses no occupied cell of the *uninflated* map. Only a
+  robot whose position is blocked in the raw map (or walled off from free space) fails with
+  :class:`~arena.core.errors.StartOccupied`.
+- **Goal inside the inflated zone** fails with :class:`~arena.core.errors.GoalOccupied`: goals
+  must be sampled with at least ``robot_radius + inflation_margin`` of clearance.
+- **Failures.** If the plan made by :meth:`~NavigationStack.reset` fails, :attr:`status` becomes
+  ``FAILED``, the typed error is kept in :attr:`last_error` and raised (never a ``None`` path);
+  :meth:`~NavigationStack.step` then only brakes. A later replan that fails keeps the previous
+  path (the static map has not changed, so the old path is still valid), records the error in
+  :attr:`last_error` and retries after ``max(replan_period, 1 s)``.
+- **Replanning** happens every ``replan_period`` seconds (0 = never) and whenever the robot is
+  more than ``max_path_deviation`` from the path (pushed by a pedestrian, say).
+- **Goal reached** when within ``goal_tolerance_xy`` and, if ``goal_tolerance_yaw`` is set, with
+  the heading within it too (enable the local planner's heading alignment then, e.g.
+  ``align_goal_heading`` of pure pursuit). The status then stays ``GOAL_REACHED``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from scipy import ndimage
+
+from arena.core.errors import ConfigError, PlanningError, StartOccupied, from_validation_error
+from arena.core.geometry import point_segment_distance
+from arena.core.types import Pose2D, wrap_angle_scalar
+from arena.maps.grid import OccupancyGrid
+from arena.nav.global_planners import GLOBAL_PLANNERS, GlobalPlanner, segment_is_free
+from arena.nav.local_planners import (
+    LOCAL_PLANNERS,
+    LocalObservation,
+    LocalPlanner,
+    limit_command,
+)
+
+
+class NavStatus(enum.StrEnum):
+    """Where a navigation run stands. Values are stable strings."""
+
+    ACTIVE = "active"
+    """Following a path toward the goal."""
+    GOAL_REACHED = "goal_reached"
+    """Within the goal tolerances; commands only brake."""
+    FAILED = "failed"
+    """The initial plan failed; the typed error is in :attr:`NavigationStack.last_error`."""
+
+
+def _planner_block(value: Any) -> Any:
+    """Normalise the shorthand ``"name"`` to ``{"type": "name"}``."""
+    return {"type": value} if isinstance(value, str) else value
+
+
+class NavigationConfig(BaseModel):
+    """The ``navigation`` block of an experiment: which planners, and the stack's policies."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    global_planner: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "astar"},
+        description="global planner block {type: name, **params}",
+    )
+    local_planner: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "pure_pursuit"},
+        description="local planner block {type: name, **params}",
+    )
+    replan_period: float = Field(1.0, ge=0, description="s between global replans; 0 = never")
+    inflation_margin: float = Field(
+        0.05, ge=0, description="m of clearance added to the robot radius when inflating the map"
+    )
+    goal_tolerance_xy: float = Field(0.3, gt=0, description="m, distance that counts as arrived")
+    goal_tolerance_yaw: float | None = Field(
+        None, gt=0, description="rad, heading error that counts as arrived; None ignores heading"
+    )
+    max_path_deviation: float = Field(
+        0.5, gt=0, description="m from the path beyond which the stack replans at once"
+    )
+
+    # The planner blocks are checked against their registries where the file and key path are
+    # known (the experiment loader, :meth:`NavigationStack.from_config`), not here: a pydantic
+    # error would lose the UnknownNameError type and the exact key path inside the block.
+    @field_validator("global_planner", "local_planner", mode="before")
+    @classmethod
+    def _shorthand(cls, v: Any) -> Any:
+        return _planner_block(v)
+
+
+_DEFAULTS = NavigationConfig()
+
+
+class NavigationStack:
+    """Global planner + local planner with replanning and goal checking, for one robot.
+
+    Args:
+        global_planner: plans on the inflated map.
+        local_planner: turns the path into commands.
+        robot_radius: radius of the robot's bounding circle (m).
+        inflation_margin: clearance added to ``robot_radius`` when inflating the map (m).
+        replan_period: seconds between replans; 0 plans only at reset (and on deviation).
+        goal_tolerance: ``(xy m, yaw rad or None)``; ``None`` ignores the heading.
+        max_path_deviation: distance from the path (m) that triggers an immediate replan.
+        kinematics: the robot's kinematics name; checked against the local planner's
+            ``supports`` and passed on in every observation. ``None`` lets the planner infer it.
+
+    Raises:
+        ConfigError: the local planner cannot drive ``kinematics``, or an argument is invalid.
+    """
+
+    def __init__(
+        self,
+        global_planner: GlobalPlanner,
+        local_planner: LocalPlanner,
+        *,
+        robot_radius: float,
+        inflation_margin: float = _DEFAULTS.inflation_margin,
+        replan_period: float = _DEFAULTS.replan_period,
+        goal_tolerance: tuple[float, float | None] = (
+            _DEFAULTS.goal_tolerance_xy,
+            _DEFAULTS.goal_tolerance_yaw,
+        ),
+        max_path_deviation: float = _DEFAULTS.max_path_deviation,
+        kinematics: str | None = None,
+    ) -> None:
+        if not robot_radius > 0:
+            raise ConfigError(f"robot_radius must be > 0 m, got {robot_radius}")
+        if inflation_margin < 0 or replan_period < 0 or not max_path_deviation > 0:
+            raise ConfigError(
+                "inflation_margin and replan_period must be >= 0 and max_path_deviation > 0, got "
+                f"{inflation_margin}, {replan_period}, {max_path_deviation}"
+            )
+        supports = getattr(local_planner, "supports", frozenset())
+        if kinematics is not None and kinematics not in supports:
+            raise ConfigError(
+                f"local planner {type(local_planner).__name__} cannot drive {kinematics!r} robots "
+                f"(supports: {', '.join(sorted(supports)) or 'none'})"
+            )
+        self.global_planner = global_planner
+        self.local_planner = local_planner
+        self.robot_radius = float(robot_radius)
+        self.inflation_margin = float(inflation_margin)
+        self.replan_period = float(replan_period)
+        self.goal_tolerance_xy = float(goal_tolerance[0])
+        self.goal_tolerance_yaw = None if goal_tolerance[1] is None else float(goal_tolerance[1])
+        self.max_path_deviation = float(max_path_deviation)
+        self.kinematics = kinematics
+        self.grid: OccupancyGrid | None = None
+        self.inflated: OccupancyGrid | None = None
+        self.goal = Pose2D()
+        self.status = NavStatus.FAILED
+        self.last_error: PlanningError | None = None
+        self.replans = 0
+        self._path = np.zeros((0, 2))
+        self._nearest_free: NDArray[np.int64] | None = None
+        self._time = 0.0
+        self._last_plan_time = 0.0
+        self._retry_after = -math.inf
+
+    @classmethod
+    def from_config(
+        cls,
+        cfg: NavigationConfig | Mapping[str, Any] | None,
+        robot_radius: float,
+        source: str | None = None,
+        *,
+        kinematics: str | None = None,
+        path: str | None = "navigation",
+    ) -> NavigationStack:
+        """Build both planners through their registries from a ``navigation`` block.
+
+        Args:
+            cfg: the block (a model, a plain mapping, or ``None`` for all defaults).
+            robot_radius: radius of the robot's bounding circle (m).
+            source: file the block came from, for error messages.
+            kinematics: the robot's kinematics name (checked against the local planner).
+            path: key path of the block inside ``source``, for error messages.
+
+        Raises:
+            ConfigError: naming ``source`` and the key path when the block is invalid.
+        """
+        sub = (lambda key: f"{path}.{key}") if path else (lambda key: key)
+        if cfg is None:
+            cfg = _DEFAULTS
+        elif not isinstance(cfg, NavigationConfig):
+            raw = dict(cfg)
+            # Check the planner blocks through their registries first: their errors keep their
+            # type (UnknownNameError with a close match) and the exact key path.
+            blocks = (("global_planner", GLOBAL_PLANNERS), ("local_planner", LOCAL_PLANNERS))
+            for key, registry in blocks:
+                if key in raw:
+                    spec = raw[key]
+                    registry.validate(
+                        {"type": spec} if isinstance(spec, str) else spec,
+                        source=source, path=sub(key),
+                    )
+            try:
+                cfg = NavigationConfig.model_validate(raw)
+            except ValidationError as e:
+                raise from_validation_error(e, source=source, prefix=path) from None
+        gp = GLOBAL_PLANNERS.build(cfg.global_planner, source=source, path=sub("global_planner"))
+        lp = LOCAL_PLANNERS.build(cfg.local_planner, source=source, path=sub("local_planner"))
+        try:
+            return cls(
+                gp, lp, robot_radius=robot_radius, inflation_margin=cfg.inflation_margin,
+                replan_period=cfg.replan_period,
+                goal_tolerance=(cfg.goal_tolerance_xy, cfg.goal_tolerance_yaw),
+                max_path_deviation=cfg.max_path_deviation, kinematics=kinematics,
+            )
+        except ConfigError as e:
+            raise e.located(source=source, prefix=path) from None
+
+    # -- state ----------------------------------------------------------------------------------
+    @property
+    def path(self) -> NDArray[np.float64]:
+        """The current global path ``(k, 2)`` (m, world frame; read-only); ``(0, 2)`` if none."""
+        return self._path
+
+    @property
+    def time(self) -> float:
+        """``obs.time`` of the last :meth:`step`, or the reset time (s)."""
+        return self._time
+
+    def goal_reached(self, pose: Pose2D | ArrayLike) -> bool:
+        """Whether ``pose`` satisfies the goal tolerances (position, and heading if set)."""
+        p = pose if isinstance(pose, Pose2D) else Pose2D.from_array(np.asarray(pose).reshape(-1))
+        if p.distance_to(self.goal) > self.goal_tolerance_xy:
+            return False
+        if self.goal_tolerance_yaw is None:
+            return True
+        return abs(wrap_angle_scalar(p.theta - self.goal.theta)) <= self.goal_tolerance_yaw
+
+    def cross_track_error(self, xy: ArrayLike) -> float:
+        """Distance (m) from the point ``(2,)`` to the current path (``inf`` without a path)."""
+        path = self._path
+        if len(path) == 0:
+            return math.inf
+        if len(path) == 1:
+            return float(np.hypot(*(np.asarray(xy, dtype=np.float64) - path[0])))
+        return float(np.min(point_segment_distance(np.asarray(xy)[None, :2], path[:-1], path[1:])))
+
+    # -- episode --------------------------------------------------------------------------------
+    def reset(
+        self, grid: OccupancyGrid, start: Pose2D, goal: Pose2D, *, time: float = 0.0
+    ) -> NavStatus:
+        """Start a new run: inflate ``grid`` once, plan from ``start`` to ``goal``.
+
+        Args:
+            grid: the static map (uninflated).
+            start: the robot's pose (m, rad).
+            goal: the goal pose (m, rad).
+            time: simulation time of the reset (s).
+
+        Returns:
+            The new :attr:`status`, ``ACTIVE``.
+
+        Raises:
+            StartOccupied: the robot cannot get out of the inflated zone (see module docstring).
+            GoalOccupied: the goal lies in the inflated zone or off the map.
+            NoPathFound: the goal is not reachable. Before any of these propagates,
+                :attr:`status` is set to ``FAILED`` and the error kept in :attr:`last_error`, so
+                a caller that catches it can still :meth:`step` (which then only brakes).
+        """
+        if grid is not self.grid or self.inflated is None:
+            # Grids are immutable, so episodes on the same map share one inflation (an EDT).
+            self.inflated = grid.inflate(self.robot_radius + self.inflation_margin)
+            self._nearest_free = None
+        self.grid = grid
+        self.goal = goal
+        self.local_planner.reset()
+        self._path = np.zeros((0, 2))
+        self._path.setflags(write=False)
+        self._time = float(time)
+        self._retry_after = -math.inf
+        self.replans = 0
+        self.last_error = None
+        try:
+            self._set_path(self._plan_from(start))
+        except PlanningError as e:
+            self.last_error = e
+            self.status = NavStatus.FAILED
+            raise
+        self.status = NavStatus.ACTIVE
+        return self.status
+
+    def replan(self, pose: Pose2D) -> bool:
+        """Plan again from ``pose``; on failure keep the old path and record :attr:`last_error`.
+
+        Returns:
+            Whether a new path was set.
+        """
+        self._require_reset()
+        self.replans += 1
+        try:
+            self._set_path(self._plan_from(pose))
+        except PlanningError as e:
+            self.last_error = e
+            self._last_plan_time = self._time
+            self._retry_after = self._time + max(self.replan_period, 1.0)
+            return False
+        return True
+
+    def step(self, obs: LocalObservation) -> NDArray[np.float64]:
+        """One control tick: check the goal, replan if due, return the local planner's command.
+
+        Args:
+            obs: the robot's observation this tick. Its ``path`` and ``goal`` are replaced by the
+                stack's own (the caller may pass :attr:`path` or an empty array); ``kinematics``
+                falls back to the stack's when ``None``. ``obs.time`` (s) drives the replanning
+                period, so it must advance.
+
+        Returns:
+            ``(3,)`` body twist command ``[vx, vy, omega]``; a braking command (zero within the
+            acceleration limits) once the goal is reached or when the initial plan failed.
+        """
+        self._require_reset()
+        q = np.asarray(obs.pose, dtype=np.float64).reshape(3)
+        v = np.asarray(obs.twist, dtype=np.float64).reshape(3)
+        self._time = float(obs.time)
+        if self.status is NavStatus.ACTIVE and self.goal_reached(Pose2D.from_array(q)):
+            self.status = NavStatus.GOAL_REACHED
+        if self.status is not NavStatus.ACTIVE:
+            return limit_command(np.zeros(3), v, obs.limits, obs.dt)
+
+        due = self.replan_period > 0 and self._time - self._last_plan_time >= self.replan_period
+        strayed = (
+            self._time >= self._retry_after
+            and self.cross_track_error(q[:2]) > self.max_path_deviation
+        )
+        if due or strayed:
+            self.replan(Pose2D.from_array(q))
+
+        local_obs = dataclasses.replace(
+            obs, path=self._path, goal=self.goal,
+            kinematics=obs.kinematics if obs.kinematics is not None else self.kinematics,
+        )
+        return np.asarray(self.local_planner.compute(local_obs), dtype=np.float64).reshape(3)
+
+    # -- internals ------------------------------------------------------------------------------
+    def _require_reset(self) -> None:
+        if self.inflated is None:
+            raise RuntimeError("NavigationStack.reset(grid, start, goal) must be called first")
+
+    def _set_path(self, path: NDArray[np.float64]) -> None:
+        p = np.array(path, dtype=np.float64).reshape(-1, 2)
+        p.setflags(write=False)
+        self._path = p
+        self._last_plan_time = self._time
+        self._retry_after = -math.inf
+
+    def _plan_from(self, start: Pose2D) -> NDArray[np.float64]:
+        assert self.inflated is not None
+        assert self.grid is not None
+        try:
+            return self.global_planner.plan(self.inflated, start, self.goal)
+        except StartOccupied:
+            free = self._free_cell_near(start)
+            if free is None:
+                raise
+        via = Pose2D(float(free[0]), float(free[1]), start.theta)
+        path = self.global_planner.plan(self.inflated, via, self.goal)
+        return np.vstack([start.xy[None, :], path])
+
+    def _free_cell_near(self, start: Pose2D) -> NDArray[np.float64] | None:
+        """Centre (m) of the inflated map's free cell nearest to ``start``, if safely reachable."""
+        assert self.inflated is not None
+        assert self.grid is not None
+        cell = self.inflated.world_to_cell(start.xy)
+        blocked = self.inflated.occupied
+        if not bool(self.inflated.in_bounds(cell)) or bool(blocked.all()):
+            return None
+        if self._nearest_free is None:
+            # One EDT with indices gives every cell's nearest free cell; computed on first need.
+            _, idx = ndimage.distance_transform_edt(blocked, return_indices=True)
+            self._nearest_free = idx
+        r, c = int(cell[0]), int(cell[1])
+        free_cell = self._nearest_free[:, r, c]
+        centre = self.inflated.cell_to_world(free_cell)
+        if not segment_is_free(self.grid, start.xy, centre):
+            return None
+        return centre

@@ -1,0 +1,64 @@
+"""The simulator interface every backend implements, and the pedestrian-driver interface.
+
+Data flow per step: the backend asks its :class:`PedestrianDriver` to advance the pedestrians
+(given the robots as they are), applies each robot's kinematics to its command, resolves
+collisions, then takes the sensor readings, and returns one :class:`SimState` snapshot.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from arena.core.registry import Registry
+from arena.sim.state import AgentStates, RobotStates, SimState, StaticWorld
+
+if TYPE_CHECKING:
+    from arena.tasks.episode import AgentSpawn, Episode
+
+
+@runtime_checkable
+class PedestrianDriver(Protocol):
+    """Owns the pedestrians' state and moves them.
+
+    A driver is reset once per episode and stepped once per simulator step. It must draw random
+    numbers only from the generator given to :meth:`reset`.
+    """
+
+    def reset(self, spawn: AgentSpawn, world: StaticWorld, rng: np.random.Generator) -> AgentStates:
+        """Place the pedestrians of an episode; return their initial state."""
+        ...
+
+    def step(self, robots: RobotStates, dt: float) -> AgentStates:
+        """Advance the pedestrians by ``dt`` seconds, seeing the robots; return the new state."""
+        ...
+
+
+@runtime_checkable
+class SimulatorBackend(Protocol):
+    """A simulator: reset from an episode, step with robot commands, return snapshots."""
+
+    @property
+    def world(self) -> StaticWorld:
+        """The static part of the current episode."""
+        ...
+
+    @property
+    def state(self) -> SimState:
+        """The latest snapshot."""
+        ...
+
+    def reset(
+        self, episode: Episode, pedestrians: PedestrianDriver | None, rng: np.random.Generator
+    ) -> SimState:
+        """Start ``episode``; ``pedestrians`` moves its agents (``None``: agents stand still)."""
+        ...
+
+    def step(self, commands: NDArray[np.float64], dt: float) -> SimState:
+        """Apply ``(r, 3)`` body-twist commands for ``dt`` seconds and return the new snapshot."""
+        ...
+
+
+BACKENDS: Registry[SimulatorBackend] = Registry("simulator backend", entry_points="arena.backends")

@@ -1,0 +1,172 @@
+"""Contact tests between robot footprints and the world (grid walls, obstacles, agents, robots).
+
+A footprint is a circle (``polygon is None``) or a convex polygon in the robot frame; non-convex
+footprints are replaced by their convex hull (conservative). Every test first rejects with a
+bounding circle, so the common "nothing near" case costs a few array look-ups.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from arena.core.geometry import (
+    bounding_radius,
+    circles_overlap_polygon,
+    convex_hull,
+    convex_polygon_overlaps_squares,
+    polygons_overlap,
+    transform_points,
+)
+from arena.maps.grid import OccupancyGrid
+from arena.sim.state import StaticWorld
+
+SQRT2 = math.sqrt(2.0)
+
+
+@dataclass(frozen=True, eq=False)
+class Footprint:
+    """A robot footprint prepared for collision tests.
+
+    Attributes:
+        polygon: ``(k, 2)`` convex polygon in the robot frame, or ``None`` for a circle.
+        radius: circle radius, or the polygon's circumscribed radius about the robot origin (m).
+    """
+
+    polygon: NDArray[np.float64] | None
+    radius: float
+
+    @classmethod
+    def make(cls, polygon: NDArray[np.float64] | None, radius: float) -> Footprint:
+        """Build from a preset footprint (polygon in the robot frame, or ``None`` and a radius)."""
+        if polygon is None:
+            return cls(None, float(radius))
+        hull = convex_hull(polygon)
+        return cls(hull, bounding_radius(hull))
+
+    def world_polygon(self, pose: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """``(k, 2)`` polygon at ``pose``, or ``None`` for a circle."""
+        return None if self.polygon is None else transform_points(self.polygon, pose)
+
+
+def hits_grid(grid: OccupancyGrid, fp: Footprint, pose: NDArray[np.float64]) -> bool:
+    """Whether the footprint at ``pose`` overlaps a blocking cell or leaves the map."""
+    x, y = float(pose[0]), float(pose[1])
+    xmin, ymin, xmax, ymax = grid.bounds
+    if not (xmin <= x < xmax and ymin <= y < ymax):
+        return True
+    r = fp.radius
+    if x - r < xmin or y - r < ymin or x + r > xmax or y + r > ymax:
+        # Near the border: only a real overhang counts.
+        pts = fp.world_polygon(pose)
+        if pts is None or (
+            pts[:, 0].min() < xmin
+            or pts[:, 1].min() < ymin
+            or pts[:, 0].max() > xmax
+            or pts[:, 1].max() > ymax
+        ):
+            return True
+    res = grid.resolution
+    col = int((x - grid.origin[0]) // res)
+    row = int((y - grid.origin[1]) // res)
+    # No blocking cell square lies nearer than EDT(centre cell) - res*sqrt2 (two half diagonals).
+    if grid.distance[row, col] - res * SQRT2 >= r:
+        return False
+    k = math.ceil(r / res) + 1
+    r0, r1 = max(row - k, 0), min(row + k + 1, grid.height)
+    c0, c1 = max(col - k, 0), min(col + k + 1, grid.width)
+    rows, cols = np.nonzero(grid.occupied[r0:r1, c0:c1])
+    if rows.size == 0:
+        return False
+    cx = grid.origin[0] + (cols + c0 + 0.5) * res
+    cy = grid.origin[1] + (rows + r0 + 0.5) * res
+    half = 0.5 * res
+    if fp.polygon is None:
+        dx = np.maximum(np.abs(cx - x) - half, 0.0)
+        dy = np.maximum(np.abs(cy - y) - half, 0.0)
+        return bool(np.any(dx * dx + dy * dy < r * r))
+    poly = transform_points(fp.polygon, pose)
+    return bool(np.any(convex_polygon_overlaps_squares(poly, np.stack([cx, cy], axis=1), half)))
+
+
+@dataclass(frozen=True, eq=False)
+class ObstacleIndex:
+    """Bounding circles of the static obstacles, for fast rejection."""
+
+    centers: NDArray[np.float64]
+    radii: NDArray[np.float64]
+    polygons: tuple[NDArray[np.float64], ...]
+
+    @classmethod
+    def build(cls, world: StaticWorld) -> ObstacleIndex:
+        """Index the obstacles of ``world``."""
+        polys = tuple(ob.polygon for ob in world.obstacles)
+        if not polys:
+            return cls(np.zeros((0, 2)), np.zeros(0), ())
+        centers = np.array([p.mean(axis=0) for p in polys])
+        radii = np.array(
+            [np.linalg.norm(p - c, axis=1).max() for p, c in zip(polys, centers, strict=True)]
+        )
+        return cls(centers, radii, polys)
+
+
+def first_obstacle_hit(index: ObstacleIndex, fp: Footprint, pose: NDArray[np.float64]) -> int:
+    """Index of one obstacle the footprint at ``pose`` overlaps, or -1."""
+    if not index.polygons:
+        return -1
+    d = np.hypot(index.centers[:, 0] - pose[0], index.centers[:, 1] - pose[1])
+    near = np.flatnonzero(d <= index.radii + fp.radius)
+    if near.size == 0:
+        return -1
+    poly = fp.world_polygon(pose)
+    for j in near:  # only the few obstacles whose bounding circles touch
+        ob = index.polygons[j]
+        if poly is None:
+            if circles_overlap_polygon(pose[None, :2], [fp.radius], ob)[0]:
+                return int(j)
+        elif polygons_overlap(poly, ob):
+            return int(j)
+    return -1
+
+
+def first_agent_hit(
+    fp: Footprint,
+    pose: NDArray[np.float64],
+    positions: NDArray[np.float64],
+    radii: NDArray[np.float64],
+) -> int:
+    """Index of the nearest pedestrian circle the footprint overlaps, or -1."""
+    if positions.shape[0] == 0:
+        return -1
+    d = np.hypot(positions[:, 0] - pose[0], positions[:, 1] - pose[1])
+    near = d < radii + fp.radius
+    if not np.any(near):
+        return -1
+    if fp.polygon is not None:
+        idx = np.flatnonzero(near)
+        hit = circles_overlap_polygon(
+            positions[idx], radii[idx], transform_points(fp.polygon, pose)
+        )
+        if not np.any(hit):
+            return -1
+        idx = idx[hit]
+        return int(idx[np.argmin(d[idx])])
+    return int(np.flatnonzero(near)[np.argmin(d[near])])
+
+
+def footprints_overlap(
+    fa: Footprint, pa: NDArray[np.float64], fb: Footprint, pb: NDArray[np.float64]
+) -> bool:
+    """Whether two robot footprints overlap."""
+    if math.hypot(pa[0] - pb[0], pa[1] - pb[1]) >= fa.radius + fb.radius:
+        return False
+    if fa.polygon is None and fb.polygon is None:
+        return True
+    if fa.polygon is None:
+        return bool(circles_overlap_polygon(pa[None, :2], [fa.radius], fb.world_polygon(pb))[0])
+    if fb.polygon is None:
+        return bool(circles_overlap_polygon(pb[None, :2], [fb.radius], fa.world_polygon(pa))[0])
+    return polygons_overlap(fa.world_polygon(pa), fb.world_polygon(pb))

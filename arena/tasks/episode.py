@@ -1,0 +1,103 @@
+"""The episode description: everything a backend needs to reset one episode.
+
+Task generators produce :class:`Episode` objects; backends consume them. Nothing here is random:
+all draws happened in the generator, so an episode is a plain, reproducible value.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from arena.core.types import Pose2D
+from arena.maps.grid import OccupancyGrid
+from arena.robots.model import RobotModel
+from arena.sim.state import Obstacle
+
+WAYPOINT_LOOP = 0
+"""Arena's ``waypoint_mode`` 0: visit the waypoints in order, then start again."""
+WAYPOINT_RANDOM = 1
+"""Arena's ``waypoint_mode`` 1: after each waypoint pick another one at random."""
+
+
+@dataclass(frozen=True, eq=False)
+class RobotSpawn:
+    """One robot of the episode: its model, start pose and goal pose."""
+
+    name: str
+    model: RobotModel
+    start: Pose2D
+    goal: Pose2D
+
+
+@dataclass(frozen=True, eq=False)
+class AgentSpawn:
+    """Pedestrians of the episode as a struct of arrays (``n`` agents, up to ``K`` waypoints).
+
+    Attributes:
+        positions: ``(n, 2)`` start positions (m).
+        radii: ``(n,)`` body radii (m).
+        vmax: ``(n,)`` preferred walking speeds (m/s).
+        waypoints: ``(n, K, 2)`` waypoints (m), rows past ``num_waypoints`` are NaN.
+        num_waypoints: ``(n,)`` number of valid waypoints per agent (≥ 1).
+        waypoint_mode: ``(n,)`` :data:`WAYPOINT_LOOP` or :data:`WAYPOINT_RANDOM`.
+        kinds: ``(n,)`` type codes (0 adult, 1 elder, 2 child).
+    """
+
+    positions: NDArray[np.float64]
+    radii: NDArray[np.float64]
+    vmax: NDArray[np.float64]
+    waypoints: NDArray[np.float64]
+    num_waypoints: NDArray[np.int64]
+    waypoint_mode: NDArray[np.int64]
+    kinds: NDArray[np.int64]
+
+    def __post_init__(self) -> None:
+        n = self.positions.shape[0]
+        for name in ("radii", "vmax", "num_waypoints", "waypoint_mode", "kinds"):
+            if getattr(self, name).shape != (n,):
+                raise ValueError(f"AgentSpawn.{name} must have shape ({n},)")
+        if self.waypoints.ndim != 3 or self.waypoints.shape[0] != n or self.waypoints.shape[2] != 2:
+            raise ValueError(f"AgentSpawn.waypoints must have shape ({n}, K, 2)")
+        if n and (
+            self.num_waypoints.min() < 1 or self.num_waypoints.max() > self.waypoints.shape[1]
+        ):
+            raise ValueError("AgentSpawn.num_waypoints must lie in [1, K]")
+
+    def __len__(self) -> int:
+        return int(self.positions.shape[0])
+
+    @classmethod
+    def empty(cls) -> AgentSpawn:
+        """No pedestrians."""
+        zi = np.zeros(0, dtype=np.int64)
+        return cls(np.zeros((0, 2)), np.zeros(0), np.zeros(0), np.zeros((0, 1, 2)), zi, zi, zi)
+
+
+@dataclass(frozen=True, eq=False)
+class Episode:
+    """One episode, fully determined.
+
+    Attributes:
+        index: episode number within its run.
+        seed: the seed the episode was drawn with (backends derive their noise streams from it).
+        map_name: a label for reports.
+        grid: the static map.
+        obstacles: placed static obstacles with real footprints.
+        robots: the robots with start and goal.
+        agents: the pedestrians.
+        time_limit: seconds of simulated time before the episode ends as a timeout.
+        goal_radius: the goal counts as reached within this distance (m).
+    """
+
+    index: int
+    seed: int
+    map_name: str
+    grid: OccupancyGrid
+    obstacles: tuple[Obstacle, ...]
+    robots: tuple[RobotSpawn, ...]
+    agents: AgentSpawn
+    time_limit: float
+    goal_radius: float = 0.3

@@ -1,0 +1,62 @@
+"""One conformance test per plugin registry: every registered plugin is run."""
+
+import pytest
+
+import arena.plugins  # noqa: F401
+from arena.core.registry import all_registries
+from arena.crowd.base import CROWD_MODELS
+from arena.maps.grid import OccupancyGrid
+from arena.maps.sources import MAP_SOURCES, MapResult
+from arena.sim.backend import BACKENDS
+from arena.tasks.base import TASKS
+from arena.testing import check_backend, check_crowd_model, check_map_source, check_task
+
+# Registry kind -> where its conformance test lives.
+COVERED = {
+    "simulator backend": "here",
+    "crowd model": "here",
+    "map source": "here",
+    "task": "here",
+    "kinematics": "tests/robots/test_kinematics.py",
+    "global planner": "tests/conformance/test_planners_conformance.py",
+    "local planner": "tests/conformance/test_planners_conformance.py",
+    "robot": "tests/robots/test_presets.py",
+}
+
+
+def test_every_registry_has_a_conformance_test():
+    kinds = {k for k in all_registries() if not k.startswith("test kind")}
+    assert kinds <= set(COVERED), f"registries without conformance test: {kinds - set(COVERED)}"
+
+
+@pytest.mark.parametrize("name", BACKENDS.names())
+def test_backend(name):
+    check_backend(lambda: BACKENDS.build(name))
+    for crowd in CROWD_MODELS.names():
+        check_backend(lambda: BACKENDS.build(name), lambda c=crowd: CROWD_MODELS.build(c), steps=5)
+
+
+@pytest.mark.parametrize("name", CROWD_MODELS.names())
+def test_crowd_model(name):
+    check_crowd_model(lambda: CROWD_MODELS.build(name))
+
+
+MAP_PARAMS = {"world": {"name": "small_office"}, "empty": {}}
+
+
+@pytest.mark.parametrize("name", MAP_SOURCES.names())
+def test_map_source(name, tmp_path):
+    if name == "file":
+        from arena.maps.io import save_map
+
+        path = save_map(OccupancyGrid.empty(6, 5, 0.1), tmp_path / "m" / "map.yaml")
+        params = {"path": str(path)}
+    else:
+        params = MAP_PARAMS[name]
+    check_map_source(MAP_SOURCES.build({"type": name, **params}))
+
+
+@pytest.mark.parametrize("name", TASKS.names())
+def test_task(name):
+    room = MapResult("room", OccupancyGrid.empty(16.0, 12.0, 0.05))
+    check_task(TASKS.build({"type": name, "min_goal_distance": 4.0}), room)

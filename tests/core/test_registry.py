@@ -1,0 +1,115 @@
+import pytest
+from pydantic import BaseModel, ConfigDict, Field
+
+from arena.core.errors import ConfigError, UnknownNameError
+from arena.core.registry import Registry, all_registries
+
+
+def make_registry(kind: str) -> Registry:
+    reg = Registry(kind)
+
+    @reg.register("social_force", tags=("default", "sfm"))
+    class SocialForce:
+        """Helbing's social force."""
+
+        class Params(BaseModel):
+            model_config = ConfigDict(frozen=True, extra="forbid")
+            relaxation_time: float = Field(0.5, gt=0)
+
+        def __init__(self, params, extra=None):
+            self.params = params
+            self.extra = extra
+
+    @reg.register("orca")
+    class Orca:
+        def __init__(self):
+            self.built = True
+
+    return reg
+
+
+def test_build_validates_params_and_passes_args():
+    reg = make_registry("test kind a")
+    obj = reg.build({"type": "social_force", "relaxation_time": 0.7}, extra=3)
+    assert obj.params.relaxation_time == 0.7
+    assert obj.extra == 3
+    assert reg.build("social_force").params.relaxation_time == 0.5
+    assert reg.build({"type": "orca"}).built
+
+
+def test_unknown_name_suggests_close_match():
+    reg = make_registry("test kind b")
+    with pytest.raises(UnknownNameError) as info:
+        reg.build({"type": "socal_force"}, source="exp.yaml", path="crowd")
+    msg = str(info.value)
+    assert "exp.yaml" in msg
+    assert "crowd.type" in msg
+    assert "did you mean 'social_force'" in msg
+    assert "orca" in msg  # lists the known names
+
+
+def test_duplicate_name_is_rejected():
+    reg = make_registry("test kind c")
+
+    class Other:
+        pass
+
+    with pytest.raises(ValueError, match="duplicate"):
+        reg.add("orca", Other)
+
+
+def test_duplicate_registry_kind_is_rejected():
+    make_registry("test kind d")
+    with pytest.raises(ValueError, match="already exists"):
+        Registry("test kind d")
+
+
+def test_params_errors_name_file_and_key_path():
+    reg = make_registry("test kind e")
+    with pytest.raises(ConfigError) as info:
+        reg.build({"type": "social_force", "relaxation_tme": 1.0}, source="a.yaml", path="crowd")
+    msg = str(info.value)
+    assert msg.startswith("a.yaml: crowd.relaxation_tme")
+    assert "unknown key" in msg
+    with pytest.raises(ConfigError, match="greater than 0"):
+        reg.build({"type": "social_force", "relaxation_time": -1})
+
+
+def test_params_on_plugin_without_params_and_missing_type():
+    reg = make_registry("test kind f")
+    with pytest.raises(ConfigError, match="takes no parameters"):
+        reg.build({"type": "orca", "radius": 1})
+    with pytest.raises(ConfigError, match="missing 'type'"):
+        reg.build({"radius": 1}, path="crowd")
+    with pytest.raises(ConfigError, match="expected a mapping"):
+        reg.build(42)  # type: ignore[arg-type]
+
+
+def test_names_tags_and_summary():
+    reg = make_registry("test kind g")
+    assert reg.names() == ["orca", "social_force"]
+    assert reg.names(tag="sfm") == ["social_force"]
+    assert "orca" in reg and "nope" not in reg
+    assert len(reg) == 2
+    assert reg.entry("social_force").summary == "Helbing's social force."
+    assert all_registries()["test kind g"] is reg
+
+
+def test_entry_points_are_loaded(monkeypatch):
+    import arena.core.registry as registry_module
+
+    class FakeEP:
+        name = "third"
+
+        def load(self):
+            class Third:
+                """A third-party plugin."""
+
+            return Third
+
+    monkeypatch.setattr(
+        registry_module, "_entry_points", lambda group: [FakeEP()] if group == "x.y" else []
+    )
+    reg = Registry("test kind h", entry_points="x.y")
+    assert reg.names() == ["third"]
+    assert reg.entry("third").tags == ("third_party",)

@@ -1,0 +1,88 @@
+"""The command line as a user meets it: outputs, tables and one-line errors."""
+
+import csv
+import json
+import sys
+
+import pytest
+
+from arena import cli
+
+
+def run_cli(monkeypatch, capsys, *args):
+    monkeypatch.setattr(sys, "argv", ["arena", *args])
+    code = 0
+    try:
+        cli.main()
+    except SystemExit as e:
+        code = e.code or 0
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_run_writes_trajectory_summary_and_video(monkeypatch, capsys, tmp_path):
+    out = tmp_path / "run"
+    code, stdout, _ = run_cli(
+        monkeypatch, capsys, "run", "task.agents=4", "task.time_limit=8", "--out", str(out),
+        "--robot", "burger", "output.width_px=320", "output.video_format=gif",
+    )
+    assert code == 0, stdout
+    ep = out / "episode_000"
+    assert (ep / "trajectory.csv").is_file()
+    assert (ep / "agents.csv").is_file()
+    assert (ep / "video.gif").is_file()
+    assert (out / "config.yaml").is_file()
+    rows = list(csv.DictReader((ep / "trajectory.csv").open()))
+    assert len(rows) > 10
+    assert float(rows[0]["time"]) == 0.0
+    info = json.loads((ep / "episode.json").read_text())
+    assert info["robot"] == "burger"
+    assert "video" in stdout and "trajectory" in stdout
+
+
+def test_robots_and_plugins_tables(monkeypatch, capsys):
+    code, out, _ = run_cli(monkeypatch, capsys, "robots")
+    assert code == 0
+    for name in ("burger", "jackal", "go1", "f1tenth"):
+        assert name in out
+    code, out, _ = run_cli(monkeypatch, capsys, "plugins")
+    assert code == 0
+    for name in ("native2d", "astar", "pure_pursuit", "waypoint_walker", "diff_drive", "ackermann"):
+        assert name in out
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["run", "robot=burgr"], "did you mean 'burger'"),
+        (["run", "task.agnets=3"], "task.agnets: unknown key"),
+        (["run", "--map", "/nonexistent/map.yaml"], "map.yaml"),
+        (["run", "/nonexistent/exp.yaml"], "file not found"),
+    ],
+)
+def test_bad_input_gives_one_line_error(monkeypatch, capsys, args, expected):
+    code, out, err = run_cli(monkeypatch, capsys, *args)
+    assert code == 2
+    assert "Traceback" not in err + out
+    assert expected in " ".join(err.split())
+    assert err.strip().startswith("error:")
+
+
+def test_missing_map_image_is_reported(monkeypatch, capsys, tmp_path):
+    (tmp_path / "map.yaml").write_text(
+        "image: gone.pgm\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    code, _, err = run_cli(monkeypatch, capsys, "run", "--map", str(tmp_path / "map.yaml"))
+    assert code == 2
+    flat = " ".join(err.split())
+    assert "map.yaml" in flat and "image" in flat and "gone.pgm" in flat
+    assert "Traceback" not in err
+
+
+def test_malformed_config_yaml(monkeypatch, capsys, tmp_path):
+    p = tmp_path / "bad.yaml"
+    p.write_text("seed: 1\n  robot: x\n")
+    code, _, err = run_cli(monkeypatch, capsys, "run", str(p))
+    assert code == 2
+    assert "malformed YAML at line" in " ".join(err.split())
