@@ -4,7 +4,8 @@ Follows Arena's random task modes (specs §2.5–2.6) with exact clearances inst
 box-filter approximation: starts and goals keep ``robot radius + clearance`` from walls and
 obstacles and lie in the same connected free region; obstacles keep ``obstacle_clearance``
 from walls and from each other; pedestrians walk round trips between waypoints that see each
-other, so even a model that ignores walls never walks through one.
+other, so even a model that ignores walls never walks through one. Everything is placed in
+cells known to be free: the unknown space around a mapped building is never used.
 """
 
 from __future__ import annotations
@@ -130,9 +131,9 @@ class RandomTask:
             for _ in range(p.max_attempts):
                 length, width = rng.uniform(*p.obstacle_size, size=2)
                 half_diag = 0.5 * float(np.hypot(length, width))
-                mask = base_clear > half_diag + p.obstacle_clearance
+                mask = (base_clear > half_diag + p.obstacle_clearance) & grid.free
                 if not mask.any():
-                    break
+                    continue  # this size does not fit anywhere; draw another
                 xy = jitter(grid, sample_cells(mask, 1, rng, what="an obstacle"), rng)[0]
                 yaw = rng.uniform(-np.pi, np.pi)
                 if all(
@@ -142,12 +143,9 @@ class RandomTask:
             else:
                 raise SamplingError(
                     f"could not place obstacle {k + 1} of {p.obstacles} on map "
-                    f"{map_result.name!r} after {p.max_attempts} tries; lower task.obstacles"
-                )
-            if not mask.any():
-                raise SamplingError(
-                    f"map {map_result.name!r} has no room for a {length:.2f}×{width:.2f} m "
-                    f"obstacle with {p.obstacle_clearance} m clearance"
+                    f"{map_result.name!r} after {p.max_attempts} tries (sizes "
+                    f"{list(p.obstacle_size)} m, clearance {p.obstacle_clearance} m); lower "
+                    "task.obstacles, task.obstacle_size or task.obstacle_clearance"
                 )
             placed.append((xy, half_diag))
             out.append(
@@ -171,7 +169,7 @@ class RandomTask:
         model: RobotModel,
     ) -> tuple[Pose2D, Pose2D]:
         p = self.params
-        ok = (clear > margin) & ~taken
+        ok = (clear > margin) & ~taken & grid.free
         labels = components(ok)
         for _ in range(p.max_attempts):
             start_cell = sample_cells(ok, 1, rng, what=f"robot {model.name!r} start")[0]
@@ -200,7 +198,7 @@ class RandomTask:
         n = p.agents
         if n == 0:
             return AgentSpawn.empty()
-        walkable = clear > p.agent_radius + 0.05
+        walkable = (clear > p.agent_radius + 0.05) & grid.free
         start_ok = walkable.copy()
         for r in robots:
             start_ok &= ~disk_mask(

@@ -92,3 +92,20 @@ def test_params_validation():
         RandomTask.Params(agent_speed=(1.0, 0.5))
     with pytest.raises(ValidationError):
         RandomTask.Params(agnets=3)  # type: ignore[call-arg]
+
+
+def test_never_samples_in_unknown_space():
+    # A free room surrounded by a large unknown area (as in SLAM maps of buildings).
+    data = np.full((200, 240), -1, dtype=np.int8)
+    data[40:160, 40:200] = 0
+    data[40, 40:200] = data[159, 40:200] = 100
+    data[40:160, 40] = data[40:160, 199] = 100
+    grid = OccupancyGrid(data, 0.05)
+    task = RandomTask(RandomTask.Params(agents=6, obstacles=2, min_goal_distance=2.0))
+    for seed in range(5):
+        ep = sample(task, MapResult("room", grid), load_robot("burger"), seed=seed)
+        pts = [ep.robots[0].start.xy, ep.robots[0].goal.xy, *ep.agents.positions]
+        pts += [o.pose[:2] for o in ep.obstacles]
+        pts += list(ep.agents.waypoints.reshape(-1, 2))
+        cells = grid.world_to_cell(np.array(pts))
+        assert np.all(grid.data[cells[:, 0], cells[:, 1]] == 0)

@@ -1,0 +1,74 @@
+"""The experiment loop end to end: determinism, outcomes, files."""
+
+import json
+
+import numpy as np
+
+from arena.config import load_config
+from arena.core.types import Outcome
+from arena.experiment import make_episode, run_episode, run_experiment
+from arena.maps.grid import OccupancyGrid
+from arena.robots.presets import load_robot
+from arena.sim.native2d import Native2DBackend
+from tests.conftest import make_episode as hand_episode
+
+FAST = [
+    "output.video=false",
+    "task.agents=6",
+    "task.obstacles=2",
+    "task.time_limit=20",
+    "task.min_goal_distance=6",
+    "episodes=2",
+]
+
+
+def test_same_seed_identical_files(tmp_path):
+    cfg = load_config(None, FAST)
+    out_a, res_a = run_experiment(cfg, tmp_path / "a")
+    out_b, res_b = run_experiment(cfg, tmp_path / "b")
+    for i in range(2):
+        for name in ("trajectory.csv", "agents.csv"):
+            a = (out_a / f"episode_{i:03d}" / name).read_bytes()
+            b = (out_b / f"episode_{i:03d}" / name).read_bytes()
+            assert a == b, f"episode {i} {name} differs between two runs with one seed"
+    assert [r.outcome for r in res_a] == [r.outcome for r in res_b]
+    other = run_experiment(load_config(None, [*FAST, "seed=1"]), tmp_path / "c")[0]
+    assert (other / "episode_000" / "trajectory.csv").read_bytes() != (
+        out_a / "episode_000" / "trajectory.csv"
+    ).read_bytes()
+
+
+def test_episodes_differ_within_a_run():
+    cfg = load_config(None, FAST)
+    e0, e1 = make_episode(cfg, 0), make_episode(cfg, 1)
+    assert e0.robots[0].start != e1.robots[0].start
+
+
+def test_success_is_reached_goal(tmp_path):
+    cfg = load_config(None, [*FAST, "task.agents=0", "task.obstacles=0", "task.time_limit=60"])
+    _, results = run_experiment(cfg, tmp_path)
+    for r in results:
+        assert r.outcome == Outcome.SUCCESS
+        assert r.final_goal_distance < 0.3
+        info = json.loads((tmp_path / f"episode_{r.index:03d}" / "episode.json").read_text())
+        assert info["outcome"] == "success"
+
+
+def test_enclosed_goal_is_a_planner_failure():
+    occ = np.zeros((200, 200), dtype=bool)
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    occ[140:180, 140] = occ[140:180, 180] = True  # a closed box around (8, 8)
+    occ[140, 140:181] = occ[180, 140:181] = True
+    grid = OccupancyGrid.from_occupied(occ, 0.05)
+    ep = hand_episode(grid, [(load_robot("burger"), (2, 2, 0), (8, 8, 0))])
+    cfg = load_config(None, ["output.video=false"])
+    res = run_episode(cfg, ep, Native2DBackend(), None)
+    assert res.outcome == Outcome.PLANNER_FAILURE
+    assert "NoPathFound" in res.error or "GoalOccupied" in res.error
+
+
+def test_timeout(tmp_path):
+    cfg = load_config(None, [*FAST, "robot=burger", "task.time_limit=2", "episodes=1"])
+    _, (res,) = run_experiment(cfg, tmp_path)
+    assert res.outcome == Outcome.TIMEOUT
+    assert abs(res.time - 2.0) < 1e-6
