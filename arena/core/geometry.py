@@ -37,8 +37,9 @@ def transform_points(points: ArrayLike, pose: ArrayLike) -> FloatArray:
 
 def to_body_frame(points: ArrayLike, pose: ArrayLike) -> FloatArray:
     """Inverse of :func:`transform_points` for one pose: world points ``(k, 2)`` → body frame."""
-    p = np.asarray(points, dtype=np.float64) - np.asarray(pose, dtype=np.float64)[:2]
-    c, s = np.cos(pose[2]), np.sin(pose[2])
+    q = np.asarray(pose, dtype=np.float64)
+    p = np.asarray(points, dtype=np.float64) - q[:2]
+    c, s = np.cos(q[2]), np.sin(q[2])
     return np.stack([c * p[:, 0] + s * p[:, 1], -s * p[:, 0] + c * p[:, 1]], axis=-1)
 
 
@@ -83,7 +84,8 @@ def points_in_polygon(points: ArrayLike, polygon: ArrayLike) -> NDArray[np.bool_
     crosses = (a[:, 1] > py) != (b[:, 1] > py)
     with np.errstate(divide="ignore", invalid="ignore"):
         x_at = a[:, 0] + (py - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    return np.count_nonzero(crosses & (px < x_at), axis=1) % 2 == 1
+    inside: NDArray[np.bool_] = np.count_nonzero(crosses & (px < x_at), axis=1) % 2 == 1
+    return inside
 
 
 def point_segment_distance(points: ArrayLike, a: ArrayLike, b: ArrayLike) -> FloatArray:
@@ -97,7 +99,8 @@ def point_segment_distance(points: ArrayLike, a: ArrayLike, b: ArrayLike) -> Flo
         t = np.einsum("...i,...i->...", p - a, ab) / denom
     t = np.clip(np.nan_to_num(t, nan=0.0), 0.0, 1.0)
     closest = a + t[..., None] * ab
-    return np.linalg.norm(p - closest, axis=-1)
+    dist: FloatArray = np.linalg.norm(p - closest, axis=-1)
+    return dist
 
 
 def segments_intersect(
@@ -137,7 +140,8 @@ def circles_overlap_polygon(
     r = np.asarray(radii, dtype=np.float64).reshape(-1)
     a, b = polygon_edges(polygon)
     near_edge = np.min(point_segment_distance(c, a, b), axis=1) <= r
-    return near_edge | points_in_polygon(c, polygon)
+    hit: NDArray[np.bool_] = near_edge | points_in_polygon(c, polygon)
+    return hit
 
 
 def polygons_overlap(p: ArrayLike, q: ArrayLike) -> bool:
@@ -194,4 +198,5 @@ def convex_polygon_overlaps_squares(
     proj_c = c @ normals.T  # (m, k_axes)
     extent = half_size * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
     ok &= np.all((proj_c - extent < pmax) & (proj_c + extent > pmin), axis=1)
-    return ok
+    result: NDArray[np.bool_] = ok
+    return result

@@ -201,9 +201,10 @@ class Registry(Generic[T]):
         Plugins without a ``Params`` model are constructed as ``cls(*args, **kwargs)``.
         """
         entry, params = self.validate(spec, source=source, path=path)
+        factory: Callable[..., T] = entry.obj
         if params is None:
-            return entry.obj(*args, **kwargs)
-        return entry.obj(params, *args, **kwargs)
+            return factory(*args, **kwargs)
+        return factory(params, *args, **kwargs)
 
     def __repr__(self) -> str:
         return f"Registry({self.kind!r}, {len(self._entries)} entries)"

@@ -235,7 +235,8 @@ def _box_kernel(
 
 def quadric_norm(v: FloatArray, weights: FloatArray) -> FloatArray:
     """``sqrt(Σ_i w_i v_i²)`` over the last axis: ≤ 1 inside the ellipsoid ``Σ w v² ≤ 1``."""
-    return np.sqrt(np.sum(weights * v * v, axis=-1))
+    norm: FloatArray = np.sqrt(np.sum(weights * v * v, axis=-1))
+    return norm
 
 
 def larger_root(a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
