@@ -42,6 +42,8 @@ class WaypointWalker:
         self._vel = np.zeros((n, 2))
         self._idx = np.zeros(n, dtype=np.int64)
         self._rows = np.arange(n)
+        self._random = (spawn.waypoint_mode == WAYPOINT_RANDOM) & (spawn.num_waypoints > 1)
+        self._no_shifts = np.zeros(n, dtype=np.int64)
         d = spawn.waypoints[self._rows, self._idx] - self._pos
         self._heading = np.arctan2(d[:, 1], d[:, 0]) if n else np.zeros(0)
         return self._snapshot()
@@ -55,12 +57,14 @@ class WaypointWalker:
             return self._snapshot()
         # Agents in random mode that arrive now draw their shift to another waypoint here, from
         # the episode's generator; the compiled kernel then only does arithmetic.
-        to_target = sp.waypoints[self._rows, self._idx] - self._pos
-        arrived = np.einsum("ij,ij->i", to_target, to_target) < self.params.arrival_radius**2
-        arriving = arrived & (sp.waypoint_mode == WAYPOINT_RANDOM) & (sp.num_waypoints > 1)
-        shifts = np.zeros(len(sp), dtype=np.int64)
-        if np.any(arriving):
-            shifts[arriving] = self._rng.integers(1, sp.num_waypoints[arriving])
+        shifts = self._no_shifts
+        if self._random.any():
+            to_target = sp.waypoints[self._rows, self._idx] - self._pos
+            arrived = np.einsum("ij,ij->i", to_target, to_target) < self.params.arrival_radius**2
+            arriving = arrived & self._random
+            if arriving.any():
+                shifts = np.zeros(len(sp), dtype=np.int64)
+                shifts[arriving] = self._rng.integers(1, sp.num_waypoints[arriving])
         _walk_kernel(
             self._pos,
             self._vel,

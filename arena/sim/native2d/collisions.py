@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from arena.core.geometry import (
@@ -141,20 +142,57 @@ def first_agent_hit(
     """Index of the nearest pedestrian circle the footprint overlaps, or -1."""
     if positions.shape[0] == 0:
         return -1
-    d = np.hypot(positions[:, 0] - pose[0], positions[:, 1] - pose[1])
-    near = d < radii + fp.radius
-    if not np.any(near):
-        return -1
-    if fp.polygon is not None:
-        idx = np.flatnonzero(near)
-        hit = circles_overlap_polygon(
-            positions[idx], radii[idx], transform_points(fp.polygon, pose)
-        )
-        if not np.any(hit):
-            return -1
-        idx = idx[hit]
-        return int(idx[np.argmin(d[idx])])
-    return int(np.flatnonzero(near)[np.argmin(d[near])])
+    poly = _EMPTY_POLY if fp.polygon is None else transform_points(fp.polygon, pose)
+    return int(_agent_hit_kernel(float(pose[0]), float(pose[1]), fp.radius, poly, positions, radii))
+
+
+_EMPTY_POLY = np.zeros((0, 2))
+
+
+@njit(cache=True)
+def _agent_hit_kernel(
+    x: float,
+    y: float,
+    radius: float,
+    poly: NDArray[np.float64],
+    positions: NDArray[np.float64],
+    radii: NDArray[np.float64],
+) -> int:
+    """Nearest circle overlapping a circle (``poly`` empty) or a convex polygon, else -1.
+
+    A circle overlaps a convex polygon when its centre is inside, or when it comes within its
+    radius of an edge (touching counts, as in :func:`circles_overlap_polygon`).
+    """
+    best, best_d = -1, np.inf
+    k = poly.shape[0]
+    for i in range(positions.shape[0]):
+        px, py, r = positions[i, 0], positions[i, 1], radii[i]
+        d = math.hypot(px - x, py - y)
+        if d >= r + radius:
+            continue  # outside the bounding circle
+        if k > 0:
+            inside = True
+            sign = 0.0
+            near = False
+            for j in range(k):
+                ax, ay = poly[j, 0], poly[j, 1]
+                bx, by = poly[(j + 1) % k, 0], poly[(j + 1) % k, 1]
+                ex, ey = bx - ax, by - ay
+                cross = ex * (py - ay) - ey * (px - ax)
+                if sign == 0.0:
+                    sign = 1.0 if cross >= 0 else -1.0
+                elif cross * sign < 0:
+                    inside = False
+                ee = ex * ex + ey * ey
+                t = ((px - ax) * ex + (py - ay) * ey) / ee if ee > 0 else 0.0
+                t = min(max(t, 0.0), 1.0)
+                if math.hypot(px - ax - t * ex, py - ay - t * ey) <= r:
+                    near = True
+            if not (inside or near):
+                continue
+        if d < best_d:
+            best, best_d = i, d
+    return best
 
 
 def footprints_overlap(
