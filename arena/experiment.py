@@ -35,7 +35,7 @@ from arena.config.schema import ExperimentConfig
 from arena.core.errors import ArenaError, PlanningError
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome
-from arena.crowd.base import CROWD_MODELS
+from arena.crowd.simulator import CrowdSimulator
 from arena.maps.raster import polygon_mask
 from arena.maps.sources import MAP_SOURCES, MapSource
 from arena.nav.local_planners.base import LocalObservation
@@ -213,7 +213,7 @@ def run_episode(
     spawn = episode.robots[0]
     robot = spawn.model
     seed, idx = cfg.seed, episode.index
-    crowd = CROWD_MODELS.build(cfg.crowd, path="crowd")
+    crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
     state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
     stack = NavigationStack.from_config(cfg.navigation, robot_radius=robot.radius)
     limits = robot.limits()
@@ -313,7 +313,8 @@ def _write_video(
         backend.world,
         lidar_specs=robot_specs,
         width_px=cfg.output.width_px,
-        title=f"{cfg.name} · {states[0].robots.models[0]}",
+        title=f"{cfg.name} · {states[0].robots.models[0]} · {cfg.crowd['type']}",
+        legend=len(states[0].agents) > 0,
     )
     video_path = out_dir / f"video.{cfg.output.video_format}"
     goals = goal.as_array()[None, :]

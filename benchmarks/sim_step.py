@@ -21,7 +21,8 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from arena.core.rng import derive_rng  # noqa: E402
-from arena.crowd.walker import WaypointWalker  # noqa: E402
+from arena.crowd.models.walker import WaypointWalker  # noqa: E402
+from arena.crowd.simulator import CrowdSimulator, PedestrianConfig  # noqa: E402
 from arena.maps.grid import OccupancyGrid  # noqa: E402
 from arena.maps.sources import MapResult  # noqa: E402
 from arena.robots.presets import load_robot  # noqa: E402
@@ -42,6 +43,11 @@ def world() -> MapResult:
     return MapResult("bench30", OccupancyGrid.from_occupied(occ, res))
 
 
+def walker() -> CrowdSimulator:
+    """People walking their waypoints (the crowd models have their own benchmark)."""
+    return CrowdSimulator(WaypointWalker(), PedestrianConfig(social_states=False))
+
+
 def main() -> None:
     """Run the benchmark and print its figures."""
     ap = argparse.ArgumentParser(description=__doc__)
@@ -57,11 +63,11 @@ def main() -> None:
     backend = Native2DBackend()
     cmd = np.array([[0.4, 0.0, 0.3]])
     dt = 0.1
-    backend.reset(ep, WaypointWalker(), derive_rng(0, "sim"))
+    backend.reset(ep, walker(), derive_rng(0, "sim"))
     for _ in range(200):  # warm-up (JIT, caches)
         backend.step(cmd, dt)
 
-    backend.reset(ep, WaypointWalker(), derive_rng(0, "sim"))
+    backend.reset(ep, walker(), derive_rng(0, "sim"))
     t0 = time.perf_counter()
     for _ in range(args.steps):
         backend.step(cmd, dt)
@@ -82,11 +88,11 @@ def main() -> None:
     rays_per_s = jackal.laser.num_beams / lidar_s
 
     # Pedestrians alone.
-    walker = WaypointWalker()
-    walker.reset(ep.agents, backend.world, derive_rng(0, "w"))
+    crowd = walker()
+    crowd.reset(ep.agents, backend.world, derive_rng(0, "w"))
     t0 = time.perf_counter()
     for _ in range(2000):
-        walker.step(st.robots, dt)
+        crowd.step(st.robots, dt)
     crowd_s = (time.perf_counter() - t0) / 2000
 
     print("native2d step benchmark (1 core)")

@@ -12,6 +12,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from arena.crowd.simulator import PedestrianConfig
 from arena.nav.stack import NavigationConfig
 
 
@@ -54,8 +55,9 @@ class ExperimentConfig(_Strict):
         default_factory=lambda: {"type": "random"}, description="{type: task, ...params}"
     )
     crowd: dict[str, Any] = Field(
-        default_factory=lambda: {"type": "waypoint_walker"}, description="{type: crowd model, ...}"
+        default_factory=lambda: {"type": "pysocial"}, description="{type: crowd model, ...}"
     )
+    pedestrians: PedestrianConfig = Field(default_factory=PedestrianConfig)
     navigation: NavigationConfig = Field(default_factory=NavigationConfig)
     sim: SimConfig = Field(default_factory=SimConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)

@@ -1,15 +1,133 @@
-"""Crowd models: what moves the pedestrians.
+"""The crowd-model plugin API (Arena's "Pedsim Waypoint Plugin", without ROS).
 
-The simulator sees pedestrians only through :class:`arena.sim.backend.PedestrianDriver`; every
-entry of :data:`CROWD_MODELS` builds one. The crowd issue's social-force family, ORCA and the
-social states plug in here without the backends changing.
+Each simulator step the :class:`~arena.crowd.simulator.CrowdSimulator` hands the configured
+model one :class:`CrowdFrame` (agents, robots, destinations, groups, walls as segments, dt) and
+gets a :class:`ModelOutput` back: accelerations ``(n, 2)`` that the simulator's one integrator
+turns into motion (``v += a·dt``, speed cap, ``p += v·dt``), or, for models that declare
+``output = "velocity"`` (ORCA, RVO2), the new velocities directly. Social states run before
+(``pre``: destinations, vmax factors) and after (``post``: force overrides) the model.
+
+Writing a model::
+
+    @CROWD_MODELS.register("my_model")
+    class MyModel:
+        output = "acceleration"
+
+        class Params(BaseModel, frozen=True, extra="forbid"):
+            tau: float = Field(0.5, gt=0, description="s, relaxation time")
+
+        def __init__(self, params: Params) -> None: ...
+        def neighbor_cutoff(self) -> float: return 5.0      # m, or math.inf for all pairs
+        def reset(self, state, world, rng) -> None: ...
+        def compute(self, frame) -> ModelOutput: ...
 """
 
 from __future__ import annotations
 
-from arena.core.registry import Registry
-from arena.sim.backend import PedestrianDriver
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, ClassVar, Literal, Protocol, runtime_checkable
 
-CROWD_MODELS: Registry[PedestrianDriver] = Registry(
-    "crowd model", entry_points="arena.crowd_models"
-)
+import numpy as np
+from numpy.typing import NDArray
+
+from arena.core.registry import Registry
+
+if TYPE_CHECKING:
+    from arena.crowd.neighbors import Neighbors
+    from arena.crowd.state import CrowdState
+    from arena.sim.state import StaticWorld
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+@dataclass(frozen=True, eq=False)
+class RobotView:
+    """The robots as pedestrians perceive them (world frame).
+
+    Attributes:
+        positions: ``(r, 2)`` m.
+        headings: ``(r,)`` rad.
+        velocities: ``(r, 2)`` m/s, world frame.
+        radii: ``(r,)`` circumscribed radius (m).
+    """
+
+    positions: FloatArray
+    headings: FloatArray
+    velocities: FloatArray
+    radii: FloatArray
+
+    def __len__(self) -> int:
+        return int(self.positions.shape[0])
+
+    @classmethod
+    def empty(cls) -> RobotView:
+        """No robots."""
+        return cls(np.zeros((0, 2)), np.zeros(0), np.zeros((0, 2)), np.zeros(0))
+
+
+@dataclass(frozen=True, eq=False)
+class CrowdFrame:
+    """Everything a crowd model may read for one step. Models must not mutate it.
+
+    Attributes:
+        state: the crowd (positions, velocities, radii, vmax, groups, types, social states ...).
+        destinations: ``(n, 2)`` where each agent heads this step (after group and social-state
+            overrides; use this, not the raw waypoints).
+        active: ``(n,)`` bool, agents that move this step (started and not finished); inactive
+            agents still repel others but must get zero acceleration.
+        robots: the robots.
+        walls_a: ``(s, 2)`` start points of the static wall and obstacle segments (m).
+        walls_b: ``(s, 2)`` end points.
+        neighbors: pedestrian pairs within the model's :meth:`CrowdModel.neighbor_cutoff`.
+        dt: step length (s).
+        rng: the crowd's generator, for models with random terms.
+    """
+
+    state: CrowdState
+    destinations: FloatArray
+    active: NDArray[np.bool_]
+    robots: RobotView
+    walls_a: FloatArray
+    walls_b: FloatArray
+    neighbors: Neighbors
+    dt: float
+    rng: np.random.Generator
+
+
+@dataclass
+class ModelOutput:
+    """What a model returns for one step.
+
+    Attributes:
+        accelerations: ``(n, 2)`` m/s² (for ``output = "acceleration"`` models).
+        velocities: ``(n, 2)`` m/s, the new velocities (for ``output = "velocity"`` models).
+        forces: per-term contributions ``name -> (n, 2)`` summing to the acceleration (optional,
+            for recording and semantic layers; e.g. ``desired``, ``social``, ``obstacle``).
+    """
+
+    accelerations: FloatArray | None = None
+    velocities: FloatArray | None = None
+    forces: dict[str, FloatArray] = field(default_factory=dict)
+
+
+@runtime_checkable
+class CrowdModel(Protocol):
+    """A pedestrian motion model."""
+
+    output: ClassVar[Literal["acceleration", "velocity"]]
+
+    def neighbor_cutoff(self) -> float:
+        """Radius (m) within which other pedestrians influence an agent (``inf``: all pairs)."""
+        ...
+
+    def reset(self, state: CrowdState, world: StaticWorld, rng: np.random.Generator) -> None:
+        """Prepare for a new episode (precompute wall data, per-agent constants ...)."""
+        ...
+
+    def compute(self, frame: CrowdFrame) -> ModelOutput:
+        """Accelerations (or velocities) for every agent; zero for inactive agents."""
+        ...
+
+
+CROWD_MODELS: Registry[CrowdModel] = Registry("crowd model", entry_points="arena.crowd_models")

@@ -85,6 +85,7 @@ class FrameRenderer:
         title: text shown at the top centre of every frame.
         margin_m: extra space around the map and obstacles (m).
         trail_length: how many past positions a recorded trail keeps.
+        legend: draw the pedestrian social-state colour legend (bottom right).
 
     Raises:
         ConfigError: ``width_px`` is too small or ``margin_m`` negative.
@@ -101,12 +102,14 @@ class FrameRenderer:
         title: str = "",
         margin_m: float = 0.0,
         trail_length: int = 600,
+        legend: bool = False,
     ) -> None:
         if width_px < 16:
             raise ConfigError(f"width_px must be at least 16 pixels, got {width_px}")
         if margin_m < 0:
             raise ConfigError(f"margin_m must be >= 0 m, got {margin_m}")
         self.world = world
+        self.legend = legend
         self.lidar_specs: tuple[LidarSpec | None, ...] = tuple(lidar_specs)
         self.show_lidar = show_lidar
         self.show_trails = show_trails
@@ -243,6 +246,8 @@ class FrameRenderer:
                 )
             )
         self._draw_scale_bar()
+        if self.legend:
+            self._draw_legend()
         fontsize = self._font_size()
         if self.title:
             ax.text(
@@ -250,6 +255,34 @@ class FrameRenderer:
                 ha="center", va="top", fontsize=fontsize * 1.15, color=style.TEXT, zorder=20,
                 bbox=self._text_box(),
             )
+
+    def _draw_legend(self) -> None:
+        """Social-state colours, bottom right, in one boxed column of coloured dots."""
+        ax = self._ax
+        fs = self._font_size() * 0.8
+        line = fs * 1.45 / 72.0 * _DPI  # pixels per legend row
+        names = style.AGENT_STATE_NAMES
+        x = 1.0 - 8.0 / self.width_px
+        for k, name in enumerate(reversed(names)):
+            code = len(names) - 1 - k
+            y = (8.0 + line * (k + 0.5)) / self.height_px
+            ax.text(
+                x, y, f"{name} \u25cf", transform=ax.transAxes, ha="right", va="center",
+                fontsize=fs, color=style.TEXT, zorder=20,
+            )
+            ax.text(
+                x, y, "\u25cf", transform=ax.transAxes, ha="right", va="center", fontsize=fs,
+                color=style.AGENT_STATE_COLORS[code], zorder=21,
+            )
+        top = (8.0 + line * len(names)) / self.height_px
+        left = 1.0 - (8.0 + fs * 7.5 / 72.0 * _DPI) / self.width_px
+        ax.add_patch(
+            Rectangle(
+                (left, 4.0 / self.height_px), 1.0 - left - 4.0 / self.width_px,
+                top - 2.0 / self.height_px, transform=ax.transAxes, facecolor=style.TEXT_BOX,
+                alpha=style.TEXT_BOX_ALPHA, edgecolor="none", zorder=19,
+            )
+        )
 
     def _font_size(self) -> float:
         # Scales with the frame so that text stays readable at 400 px and not huge at 1600 px.

@@ -46,20 +46,31 @@ COLLISION: RGB = hex_rgb("#e3121b")
 HEADING: RGB = hex_rgb("#10131a")
 
 # -- pedestrians ----------------------------------------------------------------------------------
-# Face colour by social-state code (AgentStates.states); 0 is plain walking. Codes beyond the
-# palette wrap around, so new crowd states always get some colour.
+# Face colour by social-state code (AgentStates.states = arena.crowd.state.SocialState). Codes
+# beyond the palette wrap around, so new crowd states always get some colour. Red stays
+# reserved for robot collisions.
 AGENT_STATE_COLORS: tuple[RGB, ...] = tuple(
     hex_rgb(c)
     for c in (
-        "#f5a623",  # 0 walking
-        "#4fb34f",  # 1
-        "#3d8fe0",  # 2
-        "#e8575f",  # 3
-        "#9b6bd6",  # 4
-        "#27c2c2",  # 5
-        "#c9b51a",  # 6
-        "#ee7fc8",  # 7
+        "#9aa5b1",  # 0 idle
+        "#f5a623",  # 1 walking
+        "#e8575f",  # 2 running
+        "#4fb34f",  # 3 interacting
+        "#9b6bd6",  # 4 talking
+        "#27c2c2",  # 5 phone
+        "#ee2fc8",  # 6 panic
+        "#c9b51a",  # 7
     )
+)
+# Legend labels, index = social-state code (must match arena.crowd.state.SocialState).
+AGENT_STATE_NAMES: tuple[str, ...] = (
+    "idle",
+    "walking",
+    "running",
+    "interacting",
+    "talking",
+    "phone",
+    "panic",
 )
 # Outline colour by kind code (AgentStates.kinds): 0 adult, 1 elder, 2 child.
 AGENT_KIND_COLORS: tuple[RGB, ...] = tuple(

@@ -44,6 +44,11 @@ class AgentSpawn:
         num_waypoints: ``(n,)`` number of valid waypoints per agent (≥ 1).
         waypoint_mode: ``(n,)`` :data:`WAYPOINT_LOOP` or :data:`WAYPOINT_RANDOM`.
         kinds: ``(n,)`` type codes (0 adult, 1 elder, 2 child).
+        groups: ``(n,)`` group ids (-1 alone), or ``None`` to let the crowd form groups.
+        startup_mode: ``(n,)`` 0 at once, 1 after ``wait_time``, 2 when a robot is within
+            ``trigger_radius``; ``None`` means all start at once.
+        wait_time: ``(n,)`` s, or ``None``.
+        trigger_radius: ``(n,)`` m, or ``None``.
     """
 
     positions: NDArray[np.float64]
@@ -53,11 +58,17 @@ class AgentSpawn:
     num_waypoints: NDArray[np.int64]
     waypoint_mode: NDArray[np.int64]
     kinds: NDArray[np.int64]
+    groups: NDArray[np.int64] | None = None
+    startup_mode: NDArray[np.int64] | None = None
+    wait_time: NDArray[np.float64] | None = None
+    trigger_radius: NDArray[np.float64] | None = None
 
     def __post_init__(self) -> None:
         n = self.positions.shape[0]
-        for name in ("radii", "vmax", "num_waypoints", "waypoint_mode", "kinds"):
-            if getattr(self, name).shape != (n,):
+        for name in ("radii", "vmax", "num_waypoints", "waypoint_mode", "kinds", "groups",
+                     "startup_mode", "wait_time", "trigger_radius"):
+            value = getattr(self, name)
+            if value is not None and value.shape != (n,):
                 raise ValueError(f"AgentSpawn.{name} must have shape ({n},)")
         if self.waypoints.ndim != 3 or self.waypoints.shape[0] != n or self.waypoints.shape[2] != 2:
             raise ValueError(f"AgentSpawn.waypoints must have shape ({n}, K, 2)")

@@ -56,6 +56,9 @@ class RandomTask:
         agent_robot_clearance: float = Field(
             1.5, ge=0, description="m, no pedestrian starts this close to a robot's start"
         )
+        elder_fraction: float = Field(
+            0.2, ge=0, le=1, description="share of elder pedestrians (Arena's crowdsim: 0.2)"
+        )
         goal_radius: float = Field(0.3, gt=0, description="m, goal reached within this distance")
         time_limit: float = Field(60.0, gt=0, description="s, episode timeout (Arena: 60 s)")
         max_attempts: int = Field(200, ge=1, description="tries per placement before failing")
@@ -229,7 +232,7 @@ class RandomTask:
             waypoints=waypoints,
             num_waypoints=num,
             waypoint_mode=np.full(n, WAYPOINT_LOOP, dtype=np.int64),
-            kinds=np.zeros(n, dtype=np.int64),
+            kinds=(rng.random(n) < p.elder_fraction).astype(np.int64),
         )
 
     def _next_waypoint(self, grid, walkable, region_cells, prev, rng) -> np.ndarray:

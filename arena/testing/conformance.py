@@ -8,7 +8,6 @@ from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
 from arena.maps.sources import MapResult, MapSource
 from arena.robots.presets import load_robot
-from arena.sim.backend import PedestrianDriver
 from arena.sim.state import RobotStates, SimState, StaticWorld
 from arena.tasks.base import Task
 from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn, Episode, RobotSpawn
@@ -79,40 +78,94 @@ def check_backend(make_backend, make_driver=lambda: None, steps: int = 20) -> No
         assert np.all(np.isfinite(s.robots.poses)), "finite poses"
 
 
-def check_crowd_model(make_model, steps: int = 50, dt: float = 0.1) -> None:
-    """A crowd model places every agent, moves them with finite values, deterministically."""
-    ep = standard_episode()
-    world = StaticWorld.build(ep.grid, ep.obstacles)
+def _crowd_episode(grid: OccupancyGrid, starts: np.ndarray, waypoints: np.ndarray) -> AgentSpawn:
+    n = starts.shape[0]
+    return AgentSpawn(
+        positions=starts,
+        radii=np.full(n, 0.3),
+        vmax=np.linspace(0.8, 1.3, n),
+        waypoints=waypoints,
+        num_waypoints=np.full(n, waypoints.shape[1]),
+        waypoint_mode=np.full(n, WAYPOINT_LOOP),
+        kinds=np.zeros(n, dtype=np.int64),
+        groups=np.full(n, -1, dtype=np.int64),
+    )
+
+
+def _run_crowd(make_model, spawn: AgentSpawn, grid: OccupancyGrid, steps: int, seed: int = 3):
+    from arena.crowd.simulator import CrowdSimulator, PedestrianConfig
+
+    sim = CrowdSimulator(make_model(), PedestrianConfig(social_states=False, group_fraction=0.0))
+    world = StaticWorld.build(grid)
     robots = RobotStates(
-        ("a",),
-        ("jackal",),
-        np.array([[1.0, 2.0, 0.0]]),
+        ("r",),
+        ("burger",),
+        np.array([[-50.0, -50.0, 0.0]]),
         np.zeros((1, 3)),
         np.zeros((1, 3)),
-        np.array([0.3]),
+        np.array([0.2]),
         (None,),
         (np.zeros(0),),
     )
-    spawn_before = ep.agents.positions.copy()
+    out = [sim.reset(spawn, world, np.random.default_rng(seed))]
+    caps = []
+    for _ in range(steps):
+        out.append(sim.step(robots, 0.1))
+        caps.append(sim.state.vmax * sim.state.vmax_factor)
+    return out, caps
 
-    def run() -> list:
-        model: PedestrianDriver = make_model()
-        assert isinstance(model, PedestrianDriver), "does not implement PedestrianDriver"
-        out = [model.reset(ep.agents, world, np.random.default_rng(3))]
-        out += [model.step(robots, dt) for _ in range(steps)]
-        return out
 
-    a, b = run(), run()
-    assert np.array_equal(ep.agents.positions, spawn_before), "the spawn must not be mutated"
-    assert np.allclose(a[0].positions, ep.agents.positions), "agents start at their spawn"
-    n = len(ep.agents)
-    for s, t in zip(a, b, strict=True):
-        assert s.positions.shape == (n, 2) and s.velocities.shape == (n, 2), "shapes"
-        assert s.headings.shape == (n,) and s.radii.shape == (n,), "shapes"
-        assert np.all(np.isfinite(s.positions)) and np.all(np.isfinite(s.velocities)), "finite"
-        assert np.array_equal(s.positions, t.positions), "same seed, same motion"
-    moved = np.linalg.norm(a[-1].positions - a[0].positions, axis=1)
-    assert np.any(moved > 0.1), "agents with waypoints must move"
+def check_crowd_model(make_model, *, reaches_waypoints: bool = True) -> None:
+    """Check a crowd model inside the crowd simulator (social states off).
+
+    Agents move finitely, within their speed caps and deterministically; they reach their
+    waypoints in an empty room; and nobody walks into a wall in 1,000 steps of two opposing
+    streams in a corridor.
+
+    Args:
+        make_model: builds a fresh model instance.
+        reaches_waypoints: check that agents reach their waypoints (False only for models whose
+            purpose contradicts it, e.g. the ``spinny`` demo that walks in circles).
+    """
+    # 1. Empty 12 x 12 m room: 8 agents cross to the opposite side and back.
+    room = OccupancyGrid.empty(12.0, 12.0, 0.05)
+    t = np.linspace(0, 2 * np.pi, 8, endpoint=False)
+    starts = 6.0 + 4.0 * np.stack([np.cos(t), np.sin(t)], axis=1)
+    goals = 6.0 - 4.0 * np.stack([np.cos(t), np.sin(t)], axis=1)
+    spawn = _crowd_episode(room, starts, np.stack([goals, starts], axis=1))
+    kept = (spawn.positions.copy(), spawn.waypoints.copy(), spawn.vmax.copy())
+    a, caps = _run_crowd(make_model, spawn, room, 300)
+    b, _ = _run_crowd(make_model, spawn, room, 300)
+    assert np.array_equal(spawn.positions, kept[0]), "the spawn positions must not be mutated"
+    assert np.array_equal(spawn.waypoints, kept[1]), "the spawn waypoints must not be mutated"
+    assert np.array_equal(spawn.vmax, kept[2]), "the spawn speeds must not be mutated"
+    for s, t_, cap in zip(a[1:], b[1:], caps, strict=True):
+        assert np.all(np.isfinite(s.positions)), "positions must stay finite"
+        assert np.all(np.isfinite(s.velocities)), "velocities must stay finite"
+        speed = np.hypot(s.velocities[:, 0], s.velocities[:, 1])
+        assert np.all(speed <= cap + 1e-9), "speed must not exceed vmax * vmax_factor"
+        assert np.array_equal(s.positions, t_.positions), "same seed, same trajectory"
+    if reaches_waypoints:
+        pos = np.array([s.positions for s in a])  # (steps, n, 2)
+        d = np.linalg.norm(pos - goals[None], axis=2).min(axis=0)
+        assert np.all(d < 0.6), (
+            f"agents must reach their waypoints; closest approach {d.max():.2f} m"
+        )
+    # 2. Corridor 20 x 3 m: two opposing streams for 1,000 steps; nobody enters a wall.
+    occ = np.zeros((80, 400), dtype=bool)
+    occ[:10, :] = occ[-10:, :] = True  # 0.5 m thick walls, 3 m free
+    occ[:, :4] = occ[:, -4:] = True
+    corridor = OccupancyGrid.from_occupied(occ, 0.05)
+    ys = np.array([1.0, 1.6, 2.2, 2.8, 1.3, 2.5])
+    left = np.stack([np.full(3, 1.5), ys[:3]], axis=1)
+    right = np.stack([np.full(3, 18.5), ys[3:]], axis=1)
+    starts = np.concatenate([left, right])
+    goals = starts.copy()
+    goals[:3, 0], goals[3:, 0] = 18.5, 1.5  # walk to the far end at the same height
+    spawn = _crowd_episode(corridor, starts, np.stack([goals, starts], axis=1))
+    c, _ = _run_crowd(make_model, spawn, corridor, 1000)
+    for s in c:
+        assert not np.any(corridor.is_occupied(s.positions)), "an agent entered a wall"
 
 
 def check_map_source(source: MapSource) -> None:

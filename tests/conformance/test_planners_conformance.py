@@ -141,11 +141,18 @@ def _random_obs(rng: np.random.Generator, kin: str) -> LocalObservation:
     path = np.vstack([pose[:2], pose[:2] + np.cumsum(steps, axis=0)])
     beams = int(rng.integers(0, 60))
     return LocalObservation(
-        pose=pose, twist=twist, goal=Pose2D(*path[-1], rng.uniform(-3, 3)), path=path,
-        limits=lim, robot_radius=float(rng.uniform(0.1, 0.5)), dt=DT,
+        pose=pose,
+        twist=twist,
+        goal=Pose2D(*path[-1], rng.uniform(-3, 3)),
+        path=path,
+        limits=lim,
+        robot_radius=float(rng.uniform(0.1, 0.5)),
+        dt=DT,
         scan_ranges=rng.uniform(0.05, 6.0, beams),
         scan_angles=rng.uniform(-math.pi, math.pi, beams),
-        scan_origin=rng.uniform(-0.1, 0.1, 2), time=float(rng.uniform(0, 100)), kinematics=kin,
+        scan_origin=rng.uniform(-0.1, 0.1, 2),
+        time=float(rng.uniform(0, 100)),
+        kinematics=kin,
     )
 
 
@@ -201,8 +208,14 @@ def test_local_planner_without_scan(name: str, kin: str) -> None:
     planner = LOCAL_PLANNERS.build({"type": name})
     lim = LIMITS[kin]
     obs = LocalObservation(
-        pose=np.zeros(3), twist=np.zeros(3), goal=Pose2D(3.0, 0.0), path=np.array([[0, 0], [3, 0]]),
-        limits=lim, robot_radius=0.3, dt=DT, kinematics=kin,
+        pose=np.zeros(3),
+        twist=np.zeros(3),
+        goal=Pose2D(3.0, 0.0),
+        path=np.array([[0, 0], [3, 0]]),
+        limits=lim,
+        robot_radius=0.3,
+        dt=DT,
+        kinematics=kin,
     )
     cmd = planner.compute(obs)
     assert cmd.shape == (3,) and np.all(np.isfinite(cmd))

@@ -5,7 +5,8 @@ import pytest
 
 from arena.core.errors import SimulationError
 from arena.core.geometry import rectangle
-from arena.crowd.walker import WaypointWalker
+from arena.crowd.models.walker import WaypointWalker
+from arena.crowd.simulator import CrowdSimulator, PedestrianConfig
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
 from arena.sim.native2d import Native2DBackend
@@ -14,6 +15,10 @@ from arena.sim.state import Obstacle
 from tests.conftest import make_episode, standing_agents
 
 DT = 0.1
+
+
+def walker():
+    return CrowdSimulator(WaypointWalker(), PedestrianConfig(social_states=False, group_fraction=0))
 
 
 def drive(backend, cmd, steps, dt=DT):
@@ -173,7 +178,7 @@ def test_pedestrians_move_with_driver(room):
     b = Native2DBackend()
     b.reset(
         make_episode(room, [(burger, (2, 2, 0), (3, 3, 0))], agents=agents),
-        WaypointWalker(),
+        walker(),
         np.random.default_rng(0),
     )
     s = drive(b, [0, 0, 0], 30)[-1]
@@ -188,7 +193,7 @@ def test_determinism_with_noise(room):
 
     def rollout():
         b = Native2DBackend()
-        b.reset(ep, WaypointWalker(), np.random.default_rng(42))
+        b.reset(ep, walker(), np.random.default_rng(42))
         return drive(b, [0.3, 0.1, 0.2], 20)
 
     a, c = rollout(), rollout()
@@ -228,3 +233,26 @@ def test_snapshots_are_not_mutated_later(room):
     kept = s1.robots.poses.copy()
     b.step(np.array([[0.2, 0, 0]]), DT)
     assert np.array_equal(s1.robots.poses, kept)
+
+
+def test_lidar_sees_two_legs(room):
+    jackal = load_robot("jackal")
+    ep = make_episode(
+        room, [(jackal, (3.0, 5.0, 0.0), (9, 5, 0))], agents=standing_agents([[6.0, 5.0]], 0.3)
+    )
+    legs = Native2DBackend(Native2DBackend.Params(pedestrian_body="legs"))
+    s = legs.reset(ep, None, np.random.default_rng(0))
+    body = Native2DBackend().reset(ep, None, np.random.default_rng(0))
+    scan_legs, scan_body = s.robots.scans[0], body.robots.scans[0]
+    angles = jackal.laser.angles() + jackal.laser.mount[2]
+    mount = jackal.laser.mount[0]
+    # Standing pedestrian facing +x (heading 0): legs at y = 5 ± 0.1, x = 6, radius 0.07.
+    k = int(np.argmin(np.abs(angles)))
+    assert abs(angles[k]) < 0.01
+    # The beam straight ahead passes between the legs (gap 0.2 - 2·0.07 = 6 cm) and hits the wall.
+    assert scan_legs[k] > 6.0 - mount
+    assert scan_body[k] == pytest.approx(3.0 - 0.3 - mount, abs=0.01)
+    hits = np.abs(scan_legs - (3.0 - 0.07 - mount)) < 0.05
+    assert hits.sum() >= 2  # both legs are seen
+    # Contacts still use the body circle.
+    assert not s.collisions.any[0]

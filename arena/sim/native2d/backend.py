@@ -46,6 +46,17 @@ class Native2DBackend:
         )
         lidar: bool = Field(True, description="simulate the robots' laser scanners")
         pedestrians_block_lidar: bool = Field(True, description="pedestrians are seen by lidar")
+        pedestrian_body: Literal["circle", "legs"] = Field(
+            "circle", description="what lidar sees of a pedestrian: its body circle or two legs"
+        )
+        leg_radius: float = Field(0.07, gt=0, description="m, radius of one leg (legs body)")
+        hip_half_width: float = Field(
+            0.1, ge=0, description="m, leg centre offset from the body axis"
+        )
+        stride_amplitude: float = Field(
+            0.25, ge=0, description="m, forward/backward swing of each leg at full walking speed"
+        )
+        stride_length: float = Field(1.4, gt=0, description="m walked per full gait cycle")
 
     def __init__(self, params: Params | None = None) -> None:
         self.params = params or self.Params()
@@ -110,6 +121,7 @@ class Native2DBackend:
             self._agents = pedestrians.reset(episode.agents, world, rng)
         else:
             self._agents = _standing_agents(episode)
+        self._walked = np.zeros(len(self._agents))
         self._last_scan_time = [-math.inf] * n
         self._scans: list[NDArray[np.float64]] = [np.zeros(0)] * n
         collisions = self._contacts(self._poses)
@@ -133,7 +145,10 @@ class Native2DBackend:
             raise SimulationError(f"dt must be > 0 s, got {dt}")
         # Pedestrians react to the robots as they were at the start of the step.
         if self._driver is not None:
+            before = self._agents.positions
             self._agents = self._driver.step(self._state.robots, dt)
+            if self._agents.positions.shape == before.shape:
+                self._walked = self._walked + np.hypot(*(self._agents.positions - before).T)
 
         new_poses = np.empty_like(self._poses)
         new_twists = np.empty_like(self._twists)
@@ -220,7 +235,9 @@ class Native2DBackend:
         NDArray[np.float64] | None,
     ]:
         """Circles and segments robot ``i`` sees besides the static world."""
-        if self.params.pedestrians_block_lidar:
+        if self.params.pedestrians_block_lidar and self.params.pedestrian_body == "legs":
+            cx, cr = self._legs(agents)
+        elif self.params.pedestrians_block_lidar:
             cx, cr = agents.positions, agents.radii
         else:
             cx, cr = np.zeros((0, 2)), np.zeros(0)
@@ -243,6 +260,27 @@ class Native2DBackend:
             np.concatenate(seg_a) if seg_a else None,
             np.concatenate(seg_b) if seg_b else None,
         )
+
+    def _legs(self, agents: AgentStates) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Two leg circles per pedestrian, swinging with a gait phase from the distance walked.
+
+        Legs sit ``hip_half_width`` either side of the heading axis and swing in antiphase by
+        ``stride_amplitude · min(1, speed / 1 m/s) · sin(phase)``; ``phase`` advances 2π per
+        ``stride_length`` walked, so a lidar sees the scissor motion trackers rely on.
+        """
+        p = self.params
+        n = len(agents)
+        if self._walked.shape[0] != n:
+            self._walked = np.zeros(n)
+        phase = 2.0 * np.pi * self._walked / p.stride_length
+        speed = np.hypot(agents.velocities[:, 0], agents.velocities[:, 1])
+        swing = p.stride_amplitude * np.minimum(1.0, speed) * np.sin(phase)
+        h = agents.headings
+        fwd = np.stack([np.cos(h), np.sin(h)], axis=1)
+        lat = np.stack([-np.sin(h), np.cos(h)], axis=1)
+        left = agents.positions + p.hip_half_width * lat + swing[:, None] * fwd
+        right = agents.positions - p.hip_half_width * lat - swing[:, None] * fwd
+        return np.concatenate([left, right]), np.full(2 * n, p.leg_radius)
 
     def _snapshot(self, collisions: Collisions) -> SimState:
         robots = RobotStates(

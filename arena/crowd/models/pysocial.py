@@ -1,0 +1,899 @@
+"""PySocialForce (Gao's implementation of Moussaïd's extended social force model), Arena's default.
+
+Arena 3.0 drives its pedestrians with PySocialForce 1.1.2 (``pysocialforce.Simulator``); this
+model computes the same forces from one :class:`~arena.crowd.base.CrowdFrame`, term by term, in
+numba, with neighbour lists instead of PySocialForce's all-pairs arrays. With ``cutoff = inf``,
+``robot_factor = 0`` and ``force_scale = 1`` the accelerations equal
+``pysocialforce.Simulator(state, groups, obstacles).compute_forces()`` to rounding
+(``tests/crowd/test_pysocial.py`` checks every term against the package).
+
+Forces per agent ``i`` (all accelerations, m/s², unit mass as in PySocialForce):
+
+* ``desired``: ``(ê_i·v0_i − v_i)/τ`` while the destination is farther than ``goal_threshold``,
+  else ``−v_i/τ`` (brake); ``ê_i`` points at the destination, ``v0_i`` is the desired speed.
+* ``social`` (Moussaïd et al. 2010, PySocialForce's vectorisation), summed over the others ``j``:
+  ``d = |r_i − r_j|``, ``e = (r_i − r_j)/d``, ``D = λ(v_j − v_i) + e``, ``t = D/|D|``,
+  ``B = γ|D|``, ``θ = atan2(t) − atan2(e)`` (*not* wrapped to (−π, π]: PySocialForce subtracts
+  the two ``arctan2`` angles, so θ lies in (−2π, 2π) and both the Gaussian and the sign see the
+  raw difference), ``f = exp(−d/B − (n'Bθ)²)·t − sign(θ)·exp(−d/B − (nBθ)²)·t⊥`` with ``t⊥``
+  the left normal ``(−t_y, t_x)``. Both ``e`` and ``D`` are the negatives of the paper's
+  (PySocialForce's ``each_diff`` is ``r_a − r_b``, despite its comment), so ``t`` points away
+  from the other; θ is unchanged by the double negation.
+* ``obstacle``: over the obstacle sample points ``o`` (every wall segment sampled at
+  ``resolution`` points per metre), ``Σ (r_i − o)/|r_i − o| · exp(−(|r_i − o| − R)/σ)`` for the
+  points with ``|r_i − o| − R < threshold + R``, ``R`` the agent radius (PySocialForce adds the
+  radius to the threshold *and* subtracts it from the distance, so the reach is
+  ``threshold + 2R`` = 3.7 m by default).
+* ``group_coherence`` (PySocialForce's ``GroupCoherenceForceAlt``, the one its simulator uses):
+  ``(c − r_i)·(tanh(δ − (k − 1)/2) + 1)/2`` with ``c`` the centre of mass of the ``k`` members.
+  pedsim's formula has ``δ = |c − r_i|``, but PySocialForce measures it with
+  ``stateutils.speeds``, which takes the norm of columns 2:4 of the ``(k, 2)`` array, an empty
+  slice, so ``δ = 0`` always and the pull is linear in ``c − r_i`` with a constant gain
+  (0.27 for pairs, 0.12 for triples). We reproduce that; ``coherence_uses_distance = True``
+  gives pedsim's intended softening.
+* ``group_repulsion``: ``Σ_j (r_i − r_j)`` over the members within ``group_repulsion_threshold``
+  (linear in the distance, as in PySocialForce).
+* ``group_gaze`` (``GroupGazeForceAlt``): ``|c_i − r_i|·(ê_i·ĉ_i)/|g_i − r_i| · ê_i`` with
+  ``c_i`` the centre of mass of the *other* members and ``g_i`` the destination.
+* ``robot`` (Arena addition, not in PySocialForce): every robot acts on every pedestrian through
+  the social term above, as if it were a pedestrian at its position with its world-frame
+  velocity (the robot's radius plays no role, as pedestrians' radii play none in the social
+  term), weighted by ``robot_factor``; ``robot_factor = 0`` reproduces PySocialForce.
+
+Conventions matched to PySocialForce (found in its source, documented where they bite):
+
+* **Effective factors.** ``pysocialforce.Simulator`` builds ``DesiredForce``, ``SocialForce``,
+  ``ObstacleForce`` and, with ``scene.enable_group``, ``GroupCoherenceForceAlt``,
+  ``GroupRepulsiveForce`` and ``GroupGazeForceAlt``. Each force reads the config section named
+  after its class in snake case, so the two ``*_alt`` forces find no section and fall back to
+  factor 1.0: the ``group_coherence_force.factor = 3.0`` and ``group_gaze_force.factor = 4.0``
+  of ``default.toml`` are never applied. Our defaults are the factors PySocialForce applies
+  (1.0, 1.0); the toml values are noted on the fields. The toml's ``goal_attractive_force``,
+  ``ped_repulsive_force``, ``space_repulsive_force`` and the gaze ``fov_phi`` belong to forces
+  the simulator does not build.
+* **Speeds.** PySocialForce has no preferred-speed input: ``PedState`` stores the speed of the
+  *first* state it sees as ``initial_speeds`` and sets ``max_speeds = max_speed_multiplier
+  (1.3) × initial_speeds``; ``DesiredForce`` drives towards ``max_speeds`` and ``step`` caps
+  ``|v|`` at the same ``max_speeds``. So its desired speed and its speed cap are one number.
+  Ours is ``vmax · vmax_factor`` (the preferred speed, which is also the simulator's hard cap):
+  ``v0_i = vmax_i · vmax_factor_i`` corresponds to PySocialForce's ``max_speeds`` =
+  1.3 × the agent's initial speed. To replay a PySocialForce scene, set
+  ``vmax = 1.3 · |v(t=0)|``.
+* **State layout.** PySocialForce's state rows are ``(px, py, vx, vy, gx, gy[, tau])`` with the
+  *absolute* goal; the ``tau`` column (``scene.tau``) is read only by the unused
+  ``GoalAttractiveForce``, ``DesiredForce`` uses ``desired_force.relaxation_time``. Arena's
+  plugin passed ``(gx − px, gy − py)`` in the goal slots (a relative goal read as absolute); we
+  use the frame's absolute destinations.
+* **Scene settings.** ``Simulator`` reads ``resolution``, ``agent_radius``, ``step_width``,
+  ``max_speed_multiplier`` and ``tau`` from the *top level* of its config, where
+  ``default.toml`` does not put them (they sit under ``[scene]``), so its code defaults apply:
+  resolution 10, agent radius 0.35, multiplier 1.3, tau 0.5, and step width **0.4** s (not the
+  toml's 1.0). Only ``scene.enable_group`` is read from its section.
+* **Time step.** ``compute_forces`` does not depend on the step width (the time step of
+  PySocialForce's own ``step``, which also zeroes velocities within 0.5 m of the goal); the
+  arena simulator integrates our accelerations with its ``dt``, so no alignment is needed.
+* **Obstacles.** A line ``(x0, x1, y0, y1)`` (x's first) becomes
+  ``int(length · resolution)`` points spread by ``np.linspace`` from start to end, both ends
+  included; lines sharing an end point give duplicated points, as in PySocialForce. One
+  deliberate difference: PySocialForce samples lines shorter than 2/``resolution`` (0.2 m) with
+  one or no point, so a small obstacle could be invisible; we sample every non-degenerate
+  segment with at least its two end points. ``agent_radius`` is one scene-wide 0.35 m in
+  PySocialForce; ``agent_radius = None`` uses each agent's own radius instead.
+* **Groups.** A group is the agents sharing a ``state.group`` id ≥ 0 (PySocialForce: a list of
+  index lists); members that are not active still count in their group's centre of mass, as
+  every listed member does in PySocialForce.
+* **Angles.** θ is the raw difference of two ``arctan2`` values, so a pair whose ``e`` and
+  ``t`` straddle the negative x-axis gets θ off by 2π and an almost vanishing force (the model
+  is not rotation invariant; which pairs are hit depends on their orientation in the world).
+  We reproduce it with one ``arctan2`` of the angle from ``e`` to ``t`` plus that ±2π;
+  ``wrap_theta = True`` gives Moussaïd's wrapped θ instead. For equal velocities (``D = e``)
+  we use θ = 0 exactly, where PySocialForce's two ``arctan2`` values may differ by rounding
+  and flip ``sign(θ)``.
+* **Degenerate cases.** Where PySocialForce divides by zero (the group gaze of an agent standing
+  on its destination, a social pair with ``D = 0``) it produces NaN, which Arena's plugin then
+  replaced by 0; we return 0 directly.
+
+Arena scaled PySocialForce's total by 0.3 before handing it to pedsim (``force_scale`` here,
+default 1.0 so that the model is PySocialForce's; set 0.3 for Arena's scale). Accelerations are
+``force_scale`` times the sum of the terms, zero for inactive agents; ``forces`` holds the scaled
+terms, which sum to the accelerations.
+
+Neighbour cutoff: a pair's social magnitude is at most ``√2 · social_factor · exp(−d/B)``
+with ``B = γ|D| ≤ γ(λΔv + 1)``, ``Δv`` the relative speed. At 10 m that bound is
+1.2e-4 m/s² for Arena's pedestrians (vmax 0.3-0.5 m/s, Δv ≤ 0.8 m/s), 0.024 m/s² for two
+people walking head-on at 1 m/s (0.075 at 8 m, 0.23 at 6 m) and 0.072 m/s² at 1.3 m/s each.
+Summed over a dense crowd (1000 agents in 40 × 40 m, random headings, all at speed v), cutting
+at 10 m changes the total acceleration by 3e-4 m/s² at most for v = 0.4 m/s, and by 0.027 m/s²
+RMS / 0.076 m/s² max for v = 1 m/s (0.08 / 0.25 at 8 m, 0.23 / 0.80 at 6 m), against desired
+forces of ``v0/τ`` ≈ 2 m/s²: a steady 0.076 m/s² moves the walking velocity by
+``F·τ`` < 4 cm/s. Hence the default ``cutoff = 10`` m; ``math.inf`` takes every pair, as
+PySocialForce does.
+
+Implementation: the social term visits each unordered pair once for both agents (the reverse
+direction has ``e' = −e``, ``D' = −D``, so the same ``|D|``, ``B`` and wrapped angle; only the
+±2π correction differs). Pairs are processed in blocks: numba kernels for the geometry, the
+angles and the accumulation, NumPy's SIMD ``arctan2`` and ``exp`` in between, about 3× faster
+than calling libm from inside a numba loop. The obstacle term scans the point grid directly.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import ClassVar, Literal
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field
+
+from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
+from arena.crowd.neighbors import CellList
+from arena.crowd.state import CrowdState
+from arena.crowd.walls import world_segments
+from arena.sim.state import StaticWorld
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+TERMS = (
+    "desired",
+    "social",
+    "obstacle",
+    "group_coherence",
+    "group_repulsion",
+    "group_gaze",
+    "robot",
+)
+"""Keys of :attr:`ModelOutput.forces`, in summation order."""
+
+_TWO_PI = 2.0 * math.pi
+_CHUNK = 8192
+"""Pairs per block of the social pipeline: a block's work arrays (~1 MB) stay in cache."""
+
+
+@CROWD_MODELS.register("pysocial", tags=("social_force", "default"))
+class PySocialModel:
+    """PySocialForce's extended social force model (Moussaïd et al. 2010), Arena's default."""
+
+    output: ClassVar[Literal["acceleration", "velocity"]] = "acceleration"
+
+    class Params(BaseModel):
+        """Parameters of :class:`PySocialModel`.
+
+        Defaults are PySocialForce 1.1.2's ``default.toml`` as its simulator applies them (see
+        the module docstring for the two group factors).
+        """
+
+        model_config = ConfigDict(frozen=True, extra="forbid")
+
+        # desired_force
+        desired_factor: float = Field(1.0, ge=0, description="dimensionless, desired_force.factor")
+        relaxation_time: float = Field(
+            0.5, gt=0, description="s, desired_force.relaxation_time (τ)"
+        )
+        goal_threshold: float = Field(
+            0.2,
+            ge=0,
+            description="m, desired_force.goal_threshold: closer than this the agent brakes",
+        )
+        # social_force
+        social_factor: float = Field(5.1, ge=0, description="m/s², social_force.factor")
+        lambda_importance: float = Field(
+            2.0,
+            ge=0,
+            description="s/m, social_force.lambda_importance: weight of the velocity difference",
+        )
+        gamma: float = Field(0.35, gt=0, description="m, social_force.gamma: B = γ|D|")
+        n: float = Field(2.0, ge=0, description="1/m, social_force.n: angular decay (turning)")
+        n_prime: float = Field(
+            3.0, ge=0, description="1/m, social_force.n_prime: angular decay (braking)"
+        )
+        # obstacle_force
+        obstacle_factor: float = Field(10.0, ge=0, description="m/s², obstacle_force.factor")
+        obstacle_sigma: float = Field(
+            0.2, gt=0, description="m, obstacle_force.sigma: decay length"
+        )
+        obstacle_threshold: float = Field(
+            3.0,
+            ge=0,
+            description="m, obstacle_force.threshold (the agent radius is added, as upstream)",
+        )
+        agent_radius: float | None = Field(
+            0.35,
+            ge=0,
+            description="m, scene.agent_radius; None uses each agent's own radius",
+        )
+        resolution: float = Field(
+            10.0, gt=0, description="1/m, scene.resolution: obstacle sample points per metre"
+        )
+        # groups
+        enable_group: bool = Field(True, description="scene.enable_group: the three group terms")
+        group_coherence_factor: float = Field(
+            1.0,
+            ge=0,
+            description="1/s², GroupCoherenceForceAlt factor (toml's 3.0 is never applied)",
+        )
+        coherence_uses_distance: bool = Field(
+            False,
+            description="soften the coherence with |c − r_i| as pedsim does; False reproduces "
+            "PySocialForce (which always uses 0)",
+        )
+        group_repulsion_factor: float = Field(
+            1.0, ge=0, description="1/s², group_repulsive_force.factor"
+        )
+        group_repulsion_threshold: float = Field(
+            0.55, ge=0, description="m, group_repulsive_force.threshold"
+        )
+        group_gaze_factor: float = Field(
+            1.0,
+            ge=0,
+            description="m/s², GroupGazeForceAlt factor (toml's 4.0 is never applied)",
+        )
+        # Arena
+        robot_factor: float = Field(
+            1.0,
+            ge=0,
+            description="dimensionless, robots act through the social term × this; "
+            "0 reproduces PySocialForce",
+        )
+        force_scale: float = Field(
+            1.0, ge=0, description="dimensionless, scale on the total (Arena used 0.3)"
+        )
+        wrap_theta: bool = Field(
+            False,
+            description="wrap the social angle θ into (−π, π] as Moussaïd intends; False "
+            "reproduces PySocialForce's raw atan2 difference",
+        )
+        cutoff: float = Field(
+            10.0,
+            gt=0,
+            description="m, social/robot interaction range; inf = all pairs (exact PySocialForce)",
+        )
+
+    def __init__(self, params: Params | None = None) -> None:
+        self.params = params or self.Params()
+        self.obstacle_points: FloatArray = np.zeros((0, 2))
+        self._cells = CellList(self.obstacle_points, 1.0)
+        self._work: dict[str, NDArray[np.generic]] | None = None
+        self._pairs = np.zeros((2, 0), dtype=np.int64)
+
+    def neighbor_cutoff(self) -> float:
+        """The social interaction range ``cutoff`` (m)."""
+        return float(self.params.cutoff)
+
+    def reset(self, state: CrowdState, world: StaticWorld, rng: np.random.Generator) -> None:
+        """Sample the episode's walls and obstacle edges into points, once."""
+        a, b = world_segments(world)
+        r = self.params.agent_radius
+        r_max = float(r) if r is not None else float(np.max(state.radii, initial=0.0))
+        self.set_obstacles(a, b, max_radius=r_max)
+
+    def set_obstacles(self, a: FloatArray, b: FloatArray, *, max_radius: float = 0.35) -> None:
+        """Use these segments as the obstacles (what :meth:`reset` does with the world's).
+
+        Args:
+            a: ``(s, 2)`` segment starts (m).
+            b: ``(s, 2)`` segment ends (m).
+            max_radius: largest agent radius to expect (m); sizes the point index.
+        """
+        self.obstacle_points = sample_segments(a, b, self.params.resolution)
+        p = self.params
+        r = p.agent_radius if p.agent_radius is not None else max_radius
+        self._cells = CellList(self.obstacle_points, p.obstacle_threshold + 2.0 * r)
+
+    def compute(self, frame: CrowdFrame) -> ModelOutput:
+        """PySocialForce's forces for every active agent (zero for inactive ones)."""
+        p = self.params
+        s = frame.state
+        n = len(s)
+        pos = np.ascontiguousarray(s.positions, dtype=np.float64)
+        vel = np.ascontiguousarray(s.velocities, dtype=np.float64)
+        dest = np.ascontiguousarray(frame.destinations, dtype=np.float64)
+        active = np.ascontiguousarray(frame.active, dtype=np.bool_)
+        terms = {k: np.zeros((n, 2)) for k in TERMS}
+        if n == 0:
+            return ModelOutput(accelerations=np.zeros((0, 2)), forces=terms)
+
+        terms["desired"] = desired_force(
+            pos, vel, dest, s.vmax * s.vmax_factor, p.relaxation_time, p.goal_threshold
+        )
+        terms["desired"] *= p.desired_factor
+
+        nb = frame.neighbors
+        self._social_term(pos, vel, active, nb.indptr, nb.indices, terms["social"])
+        terms["social"] *= p.social_factor
+
+        if len(frame.robots) and p.robot_factor > 0.0:
+            _robots(
+                pos,
+                vel,
+                active,
+                np.ascontiguousarray(frame.robots.positions, dtype=np.float64),
+                np.ascontiguousarray(frame.robots.velocities, dtype=np.float64),
+                float(p.cutoff),
+                p.lambda_importance,
+                p.gamma,
+                p.n,
+                p.n_prime,
+                p.wrap_theta,
+                terms["robot"],
+            )
+            terms["robot"] *= p.robot_factor * p.social_factor
+
+        if self.obstacle_points.shape[0]:
+            radii = (
+                np.full(n, float(p.agent_radius))
+                if p.agent_radius is not None
+                else np.ascontiguousarray(s.radii, dtype=np.float64)
+            )
+            cells = self._cells
+            _obstacle(
+                pos,
+                radii,
+                active,
+                cells.points,
+                cells.order,
+                cells.starts,
+                float(cells.origin[0]),
+                float(cells.origin[1]),
+                float(cells.cell),
+                int(cells.shape[0]),
+                int(cells.shape[1]),
+                # Slightly wider than the reach: the kernel applies PySocialForce's exact test.
+                p.obstacle_threshold + 2.0 * float(radii.max()) + 1e-9,
+                p.obstacle_threshold,
+                p.obstacle_sigma,
+                terms["obstacle"],
+            )
+            terms["obstacle"] *= p.obstacle_factor
+
+        if p.enable_group:
+            order, starts = group_members(s.group)
+            if starts.shape[0] > 1:
+                _groups(
+                    pos,
+                    dest,
+                    active,
+                    order,
+                    starts,
+                    p.group_repulsion_threshold,
+                    p.coherence_uses_distance,
+                    terms["group_coherence"],
+                    terms["group_repulsion"],
+                    terms["group_gaze"],
+                )
+                terms["group_coherence"] *= p.group_coherence_factor
+                terms["group_repulsion"] *= p.group_repulsion_factor
+                terms["group_gaze"] *= p.group_gaze_factor
+
+        acc = np.zeros((n, 2))
+        for k in TERMS:
+            f = terms[k]
+            f[~active] = 0.0
+            if p.force_scale != 1.0:
+                f *= p.force_scale
+            acc += f
+        return ModelOutput(accelerations=acc, forces=terms)
+
+    def _social_term(
+        self,
+        pos: FloatArray,
+        vel: FloatArray,
+        active: NDArray[np.bool_],
+        indptr: IntArray,
+        indices: IntArray,
+        out: FloatArray,
+    ) -> None:
+        """Add the pedestrian interaction (before its factor) to ``out`` ``(n, 2)``.
+
+        Each unordered pair is evaluated once for both agents, in blocks: numba kernels for the
+        geometry, the angles and the accumulation, NumPy's SIMD ``arctan2`` and ``exp`` in
+        between (several times faster than scalar libm calls from inside a numba loop).
+        """
+        p = self.params
+        # Work arrays live across steps: fresh large arrays would page-fault every step.
+        if self._pairs.shape[1] < indices.shape[0]:
+            self._pairs = np.empty((2, int(indices.shape[0] * 1.25) + 16), dtype=np.int64)
+        pi = self._pairs[0]
+        pj = self._pairs[1]
+        m = _pair_list(active, indptr, indices, pi, pj)
+        if m == 0:
+            return
+        k = min(m, _CHUNK)
+        if self._work is None or self._work["sn"].shape[0] < k:
+            self._work = {
+                "sn": np.empty(k),
+                "cs": np.empty(k),
+                "base": np.empty(k),
+                "bb": np.empty(k),
+                "tx": np.empty(k),
+                "ty": np.empty(k),
+                "code": np.empty(k, dtype=np.int64),
+                "w": np.empty(k),
+                "args": np.empty((4, k)),
+                "ex": np.empty((4, k)),
+                "sg": np.empty((2, k)),
+            }
+        wk = self._work
+        for lo in range(0, m, _CHUNK):  # a few blocks per step; the per-pair work is compiled
+            hi = min(lo + _CHUNK, m)
+            c = hi - lo
+            _pair_geometry(
+                pos,
+                vel,
+                pi,
+                pj,
+                lo,
+                hi,
+                float(p.cutoff),
+                p.lambda_importance,
+                p.gamma,
+                wk["sn"],
+                wk["cs"],
+                wk["base"],
+                wk["bb"],
+                wk["tx"],
+                wk["ty"],
+                wk["code"],
+            )
+            np.arctan2(wk["sn"][:c], wk["cs"][:c], out=wk["w"][:c])
+            _pair_exponents(
+                wk["w"],
+                wk["code"],
+                wk["base"],
+                wk["bb"],
+                wk["tx"],
+                wk["ty"],
+                c,
+                p.n,
+                p.n_prime,
+                p.wrap_theta,
+                wk["args"],
+                wk["sg"],
+            )
+            with np.errstate(under="ignore"):  # distant pairs: exp → 0 is the right answer
+                np.exp(wk["args"][:, :c], out=wk["ex"][:, :c])
+            _pair_accumulate(pi, pj, lo, hi, wk["tx"], wk["ty"], wk["ex"], wk["sg"], out)
+
+
+def desired_force(
+    pos: FloatArray,
+    vel: FloatArray,
+    dest: FloatArray,
+    speed: FloatArray,
+    relaxation_time: float,
+    goal_threshold: float,
+) -> FloatArray:
+    """PySocialForce's ``DesiredForce`` before its factor.
+
+    Args:
+        pos: ``(n, 2)`` positions (m).
+        vel: ``(n, 2)`` velocities (m/s).
+        dest: ``(n, 2)`` destinations (m).
+        speed: ``(n,)`` desired speeds (m/s).
+        relaxation_time: τ (s).
+        goal_threshold: distance (m) within which the agent brakes instead.
+
+    Returns:
+        ``(n, 2)`` m/s².
+    """
+    delta = dest - pos
+    dist = np.hypot(delta[:, 0], delta[:, 1])
+    direction = np.divide(delta, dist[:, None], out=np.zeros_like(delta), where=dist[:, None] > 0)
+    far = (dist > goal_threshold)[:, None]
+    return np.where(far, direction * speed[:, None] - vel, -vel) / relaxation_time
+
+
+def sample_segments(a: FloatArray, b: FloatArray, resolution: float) -> FloatArray:
+    """Obstacle points along segments the way PySocialForce's ``EnvState`` samples lines.
+
+    ``int(length · resolution)`` points per segment by ``np.linspace`` arithmetic (start plus
+    ``k`` steps of ``(end − start)/(count − 1)``, the last point exactly the end), at least the
+    two end points; zero-length segments give none.
+
+    Args:
+        a: ``(s, 2)`` segment starts (m).
+        b: ``(s, 2)`` segment ends (m).
+        resolution: points per metre.
+
+    Returns:
+        ``(m, 2)`` points (m), segment by segment.
+    """
+    a = np.asarray(a, dtype=np.float64).reshape(-1, 2)
+    b = np.asarray(b, dtype=np.float64).reshape(-1, 2)
+    # Each length exactly as PySocialForce computes it (a 2-vector norm, i.e. a dot product
+    # that may fuse multiply-adds): int() truncation turns a last-bit difference, e.g. 6 m as
+    # 59.99999999999999 samples, into one point more or less. Once per episode, per segment.
+    length = np.array([np.linalg.norm(d) for d in a - b], dtype=np.float64)
+    counts = np.where(length > 0, np.maximum((length * resolution).astype(np.int64), 2), 0)
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros((0, 2))
+    owner = np.repeat(np.arange(a.shape[0]), counts)
+    k = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+    step = (b - a) / np.maximum(counts - 1, 1)[:, None]
+    pts = a[owner] + k[:, None] * step[owner]
+    last = np.cumsum(counts)[counts > 0] - 1
+    pts[last] = b[counts > 0]
+    return pts
+
+
+def group_members(group: IntArray) -> tuple[IntArray, IntArray]:
+    """Agents of each group (id ≥ 0) contiguous, in index order within a group.
+
+    Returns:
+        ``(order, starts)``: the members of the ``g``-th group are
+        ``order[starts[g]:starts[g + 1]]``.
+    """
+    g = np.asarray(group, dtype=np.int64)
+    grouped = np.flatnonzero(g >= 0)
+    if grouped.size == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64)
+    order = grouped[np.argsort(g[grouped], kind="stable")]
+    ids = g[order]
+    starts = np.r_[0, np.flatnonzero(np.diff(ids)) + 1, ids.size].astype(np.int64)
+    return order.astype(np.int64), starts
+
+
+@njit(cache=True)
+def _pair_list(
+    active: NDArray[np.bool_], indptr: IntArray, indices: IntArray, pi: IntArray, pj: IntArray
+) -> int:
+    """Unordered pairs ``i < j`` of the (symmetric) neighbour lists with an active member."""
+    m = 0
+    for i in range(indptr.shape[0] - 1):
+        ai = active[i]
+        for k in range(indptr[i], indptr[i + 1]):
+            j = indices[k]
+            if j > i and (ai or active[j]):
+                pi[m] = i
+                pj[m] = j
+                m += 1
+    return m
+
+
+@njit(cache=True, inline="always")
+def _upper(x: float, y: float) -> int:
+    """1 if ``atan2(y, x) > 0``, else 0 (signed zeros included: ``atan2(+0, x < 0) = +π``)."""
+    if y == 0.0:  # rare: only exact zeros need the sign bit
+        return 1 if (x < 0.0 and math.copysign(1.0, y) > 0.0) else 0
+    return 1 if y > 0.0 else 0
+
+
+@njit(cache=True)
+def _pair_geometry(
+    pos: FloatArray,
+    vel: FloatArray,
+    pi: IntArray,
+    pj: IntArray,
+    lo: int,
+    hi: int,
+    cutoff: float,
+    lam: float,
+    gamma: float,
+    sn: FloatArray,
+    cs: FloatArray,
+    base: FloatArray,
+    bb: FloatArray,
+    tx: FloatArray,
+    ty: FloatArray,
+    code: IntArray,
+) -> None:
+    """Per pair ``lo..hi``: the atan2 arguments, ``−d/B``, ``B``, ``t`` and the half-plane bits.
+
+    ``e``, ``D`` and ``t`` are PySocialForce's for agent ``i`` (``e = (r_i − r_j)/d``,
+    ``D = λ(v_j − v_i) + e``); agent ``j`` sees ``−e`` and ``−D``, hence the same ``|D|``, ``B``
+    and wrapped angle ``w`` from ``e`` to ``t``. PySocialForce's raw ``θ = atan2(t) − atan2(e)``
+    is ``w`` shifted by ∓2π where the rotation from ``e`` to ``t`` crosses the negative x-axis;
+    the bits record which half-plane each of the four vectors lies in (from the reverse vectors
+    formed as PySocialForce forms them, so signed zeros match) and ``d = 0``.
+    """
+    c2 = cutoff * cutoff
+    for p in range(lo, hi):
+        q = p - lo
+        i = pi[p]
+        j = pj[p]
+        px = pos[i, 0]
+        py = pos[i, 1]
+        ox = pos[j, 0]
+        oy = pos[j, 1]
+        dvx = vel[j, 0] - vel[i, 0]
+        dvy = vel[j, 1] - vel[i, 1]
+        dx = px - ox
+        dy = py - oy
+        d2 = dx * dx + dy * dy
+        d = math.sqrt(d2)
+        inv_d = 1.0 / d if d > 0.0 else 0.0  # e = 0 for coincident agents, as upstream
+        ex = dx * inv_d
+        ey = dy * inv_d
+        rex = (ox - px) * inv_d
+        rey = (oy - py) * inv_d
+        ix = lam * dvx + ex
+        iy = lam * dvy + ey
+        length = math.sqrt(ix * ix + iy * iy)
+        inv_l = 1.0 / length if length > 0.0 else 0.0
+        t_x = ix * inv_l
+        t_y = iy * inv_l
+        rtx = (lam * (vel[i, 0] - vel[j, 0]) + rex) * inv_l
+        rty = (lam * (vel[i, 1] - vel[j, 1]) + rey) * inv_l
+        if d == 0.0:
+            sn[q] = t_y  # e = 0: θ = atan2(t)
+            cs[q] = t_x
+        elif dvx == 0.0 and dvy == 0.0:
+            sn[q] = 0.0  # D = e: θ = 0 exactly, not ±1 ulp of rounding noise
+            cs[q] = 1.0
+        else:
+            sn[q] = ex * t_y - ey * t_x
+            cs[q] = ex * t_x + ey * t_y
+        # Outside the cutoff (a wider neighbour search) or D = 0: both directions exactly 0
+        # (upstream's 0·exp(−d/0); NaN if d = 0 too, which Arena zeroed).
+        base[q] = -d * inv_l / gamma if (length > 0.0 and d2 < c2) else -math.inf
+        bb[q] = gamma * length
+        tx[q] = t_x
+        ty[q] = t_y
+        if ey == 0.0 or t_y == 0.0 or rey == 0.0 or rty == 0.0:  # rare: signed zeros matter
+            code[q] = (
+                _upper(ex, ey)
+                + 2 * _upper(t_x, t_y)
+                + 4 * _upper(rex, rey)
+                + 8 * _upper(rtx, rty)
+                + (16 if d == 0.0 else 0)
+            )
+        else:
+            code[q] = (ey > 0.0) + 2 * (t_y > 0.0) + 4 * (rey > 0.0) + 8 * (rty > 0.0)
+
+
+@njit(cache=True, inline="always")
+def _unwrap(w: float, upper_e: bool, upper_t: bool) -> float:
+    """``atan2(t) − atan2(e)`` from the wrapped angle ``w`` from ``e`` to ``t``."""
+    if upper_e and not upper_t and w > 0.0:
+        return w - _TWO_PI  # counter-clockwise through the negative x-axis
+    if upper_t and not upper_e and w < 0.0:
+        return w + _TWO_PI  # clockwise through it
+    return w
+
+
+@njit(cache=True)
+def _pair_exponents(
+    w: FloatArray,
+    code: IntArray,
+    base: FloatArray,
+    bb: FloatArray,
+    tx: FloatArray,
+    ty: FloatArray,
+    m: int,
+    n: float,
+    n_prime: float,
+    wrap: bool,
+    args: FloatArray,
+    sg: FloatArray,
+) -> None:
+    """θ for both agents of each pair, the four exponents and the signs of θ."""
+    for q in range(m):
+        cd = code[q]
+        wq = w[q]
+        if cd & 16:  # d = 0: each agent's θ is the angle of its own t (upstream e = 0)
+            th_i = wq
+            rtx = -tx[q] if tx[q] != 0.0 else 0.0
+            rty = -ty[q] if ty[q] != 0.0 else 0.0
+            th_j = math.atan2(rty, rtx)
+        elif wrap:
+            th_i = wq
+            th_j = wq
+        else:
+            th_i = _unwrap(wq, (cd & 1) != 0, (cd & 2) != 0)
+            th_j = _unwrap(wq, (cd & 4) != 0, (cd & 8) != 0)
+        b = bb[q]
+        bs = base[q]
+        args[0, q] = bs - (n_prime * b * th_i) ** 2
+        args[1, q] = bs - (n * b * th_i) ** 2
+        args[2, q] = bs - (n_prime * b * th_j) ** 2
+        args[3, q] = bs - (n * b * th_j) ** 2
+        sg[0, q] = (th_i > 0.0) - (th_i < 0.0)
+        sg[1, q] = (th_j > 0.0) - (th_j < 0.0)
+
+
+@njit(cache=True)
+def _pair_accumulate(
+    pi: IntArray,
+    pj: IntArray,
+    lo: int,
+    hi: int,
+    tx: FloatArray,
+    ty: FloatArray,
+    ex: FloatArray,
+    sg: FloatArray,
+    out: FloatArray,
+) -> None:
+    """``exp(..)·t − sign(θ)·exp(..)·t⊥`` on ``i`` and, with ``t' = −t``, on ``j``."""
+    for p in range(lo, hi):
+        q = p - lo
+        i = pi[p]
+        j = pj[p]
+        t_x = tx[q]
+        t_y = ty[q]
+        fv = ex[0, q]
+        fa = -sg[0, q] * ex[1, q]
+        out[i, 0] += fv * t_x - fa * t_y
+        out[i, 1] += fv * t_y + fa * t_x
+        fv = ex[2, q]
+        fa = -sg[1, q] * ex[3, q]
+        out[j, 0] -= fv * t_x - fa * t_y
+        out[j, 1] -= fv * t_y + fa * t_x
+
+
+@njit(cache=True)
+def _robots(
+    pos: FloatArray,
+    vel: FloatArray,
+    active: NDArray[np.bool_],
+    rpos: FloatArray,
+    rvel: FloatArray,
+    cutoff: float,
+    lam: float,
+    gamma: float,
+    n: float,
+    n_prime: float,
+    wrap: bool,
+    out: FloatArray,
+) -> None:
+    """Add the social interaction of every robot within ``cutoff`` on each active agent.
+
+    The pedestrian formula written out directly (few robots, so no pair pipeline).
+    """
+    c2 = cutoff * cutoff
+    for i in range(pos.shape[0]):
+        if not active[i]:
+            continue
+        for r in range(rpos.shape[0]):
+            dx = pos[i, 0] - rpos[r, 0]
+            dy = pos[i, 1] - rpos[r, 1]
+            d2 = dx * dx + dy * dy
+            if d2 >= c2:
+                continue
+            d = math.sqrt(d2)
+            ex = dx / d if d > 0.0 else 0.0
+            ey = dy / d if d > 0.0 else 0.0
+            ix = lam * (rvel[r, 0] - vel[i, 0]) + ex
+            iy = lam * (rvel[r, 1] - vel[i, 1]) + ey
+            length = math.sqrt(ix * ix + iy * iy)
+            if length == 0.0:
+                continue
+            t_x = ix / length
+            t_y = iy / length
+            theta = math.atan2(t_y, t_x) - math.atan2(ey, ex)
+            if wrap:
+                theta = theta - _TWO_PI if theta > math.pi else theta
+                theta = theta + _TWO_PI if theta <= -math.pi else theta
+            b = gamma * length
+            fv = math.exp(-d / b - (n_prime * b * theta) ** 2)
+            fa = -((theta > 0.0) - (theta < 0.0)) * math.exp(-d / b - (n * b * theta) ** 2)
+            out[i, 0] += fv * t_x - fa * t_y
+            out[i, 1] += fv * t_y + fa * t_x
+
+
+@njit(cache=True)
+def _obstacle(
+    pos: FloatArray,
+    radii: FloatArray,
+    active: NDArray[np.bool_],
+    pts: FloatArray,
+    order: IntArray,
+    starts: IntArray,
+    gx0: float,
+    gy0: float,
+    cell: float,
+    nx: int,
+    ny: int,
+    reach: float,
+    threshold: float,
+    sigma: float,
+    out: FloatArray,
+) -> None:
+    """PySocialForce's ``ObstacleForce`` (before its factor), scanning the point grid directly.
+
+    ``order``/``starts`` and the grid geometry are a :class:`CellList`'s; ``reach`` bounds the
+    search, the exact PySocialForce test ``|r − o| − R < threshold + R`` selects the points.
+    """
+    rings = max(1, math.ceil(reach / cell))
+    for i in range(pos.shape[0]):
+        if not active[i]:
+            continue
+        x, y = pos[i, 0], pos[i, 1]
+        r = radii[i]
+        thr = threshold + r
+        # Cheap squared-distance prefilter, a hair wider than the exact test below.
+        far2 = (thr + r) * (thr + r) * (1.0 + 1e-9)
+        cx = int((x - gx0) // cell)
+        cy = int((y - gy0) // cell)
+        fx = 0.0
+        fy = 0.0
+        for gy in range(max(cy - rings, 0), min(cy + rings, ny - 1) + 1):
+            for gx in range(max(cx - rings, 0), min(cx + rings, nx - 1) + 1):
+                c = gy * nx + gx
+                for s in range(starts[c], starts[c + 1]):
+                    j = order[s]
+                    dx = x - pts[j, 0]
+                    dy = y - pts[j, 1]
+                    d2 = dx * dx + dy * dy
+                    if d2 >= far2:
+                        continue
+                    dist = math.sqrt(d2)
+                    gap = dist - r
+                    if gap < thr and dist > 0.0:
+                        w = math.exp(-gap / sigma)
+                        fx += dx / dist * w
+                        fy += dy / dist * w
+        out[i, 0] += fx
+        out[i, 1] += fy
+
+
+@njit(cache=True)
+def _groups(
+    pos: FloatArray,
+    dest: FloatArray,
+    active: NDArray[np.bool_],
+    order: IntArray,
+    starts: IntArray,
+    rep_threshold: float,
+    coherence_uses_distance: bool,
+    coherence: FloatArray,
+    repulsion: FloatArray,
+    gaze: FloatArray,
+) -> None:
+    """The three group terms (before their factors), group by group."""
+    for g in range(starts.shape[0] - 1):
+        lo = starts[g]
+        hi = starts[g + 1]
+        k = hi - lo
+        sx = 0.0
+        sy = 0.0
+        for a in range(lo, hi):
+            sx += pos[order[a], 0]
+            sy += pos[order[a], 1]
+        cx = sx / k
+        cy = sy / k
+        half = (k - 1) / 2.0
+        for a in range(lo, hi):
+            i = order[a]
+            if not active[i]:
+                continue
+            px, py = pos[i, 0], pos[i, 1]
+            # Coherence: towards the centre of mass, softened around (k − 1)/2 m (upstream's
+            # distance is always 0, see the module docstring).
+            wx = cx - px
+            wy = cy - py
+            delta = math.sqrt(wx * wx + wy * wy) if coherence_uses_distance else 0.0
+            soft = (math.tanh(delta - half) + 1.0) / 2.0
+            coherence[i, 0] += wx * soft
+            coherence[i, 1] += wy * soft
+            # Repulsion: linear push from members within the threshold; gaze: others' centre.
+            ox = 0.0
+            oy = 0.0
+            for b in range(lo, hi):
+                j = order[b]
+                if j == i:
+                    continue
+                dx = px - pos[j, 0]
+                dy = py - pos[j, 1]
+                if math.sqrt(dx * dx + dy * dy) <= rep_threshold:
+                    repulsion[i, 0] += dx
+                    repulsion[i, 1] += dy
+                ox += pos[j, 0]
+                oy += pos[j, 1]
+            if k < 2:
+                continue
+            rx = ox / (k - 1) - px
+            ry = oy / (k - 1) - py
+            com_dist = math.sqrt(rx * rx + ry * ry)
+            gx = dest[i, 0] - px
+            gy = dest[i, 1] - py
+            goal_dist = math.sqrt(gx * gx + gy * gy)
+            if com_dist == 0.0 or goal_dist == 0.0:
+                continue  # upstream: 0 or NaN (zeroed by Arena)
+            ux = gx / goal_dist
+            uy = gy / goal_dist
+            cos = ux * rx / com_dist + uy * ry / com_dist
+            scale = com_dist * cos / goal_dist
+            gaze[i, 0] += scale * ux
+            gaze[i, 1] += scale * uy

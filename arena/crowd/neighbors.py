@@ -1,0 +1,263 @@
+"""Neighbour search with a cell list (numba): pairs within a cutoff in O(n) for bounded density.
+
+Every crowd model gets its pedestrian pairs from here, and models with many static points
+(wall samples) build a :class:`CellList` over them once per episode.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+_MAX_CELLS = 4_000_000  # dense cell table cap; coarser cells beyond it
+
+
+@dataclass(frozen=True, eq=False)
+class Neighbors:
+    """Neighbour lists in CSR form.
+
+    The neighbours of query ``i`` are ``indices[indptr[i]:indptr[i + 1]]``, each strictly
+    closer than ``cutoff``; a point is never its own neighbour in a self-query. The order is
+    deterministic (cell by cell) but not sorted; models that need nearest-first sort.
+
+    Attributes:
+        indptr: ``(q + 1,)`` offsets.
+        indices: ``(m,)`` neighbour indices.
+        cutoff: the search radius (m); ``inf`` means all pairs.
+    """
+
+    indptr: IntArray
+    indices: IntArray
+    cutoff: float
+
+    def __len__(self) -> int:
+        return int(self.indptr.shape[0] - 1)
+
+    def of(self, i: int) -> IntArray:
+        """Neighbours of query ``i``."""
+        return self.indices[self.indptr[i] : self.indptr[i + 1]]
+
+    def pairs(self) -> tuple[IntArray, IntArray]:
+        """``(i, j)`` arrays of every listed pair (each unordered pair appears twice)."""
+        counts = np.diff(self.indptr)
+        return np.repeat(np.arange(len(self), dtype=np.int64), counts), self.indices
+
+
+class CellList:
+    """A uniform grid over fixed points for radius queries.
+
+    Args:
+        points: ``(n, 2)`` points (copied).
+        cell_size: edge of a grid cell (m); queries with radius ≤ cell_size look at 3×3 cells.
+    """
+
+    def __init__(self, points: FloatArray, cell_size: float) -> None:
+        pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
+        self.points = pts
+        n = pts.shape[0]
+        if n == 0:
+            self.origin = np.zeros(2)
+            self.cell = 1.0
+            self.shape = (1, 1)
+            self.order = np.zeros(0, dtype=np.int64)
+            self.starts = np.zeros(2, dtype=np.int64)
+            return
+        lo = pts.min(axis=0)
+        hi = pts.max(axis=0)
+        cell = max(float(cell_size), 1e-6)
+        nx = math.floor((hi[0] - lo[0]) / cell) + 1
+        ny = math.floor((hi[1] - lo[1]) / cell) + 1
+        while nx * ny > _MAX_CELLS:  # sparse, huge extents: coarser cells, still correct
+            cell *= 2.0
+            nx = math.floor((hi[0] - lo[0]) / cell) + 1
+            ny = math.floor((hi[1] - lo[1]) / cell) + 1
+        self.origin = lo
+        self.cell = cell
+        self.shape = (nx, ny)
+        self.order, self.starts = _build(pts, lo[0], lo[1], cell, nx, ny)
+
+    def query(self, queries: FloatArray, radius: float, *, exclude_self: bool = False) -> Neighbors:
+        """Indices of the points strictly within ``radius`` of each query.
+
+        Args:
+            queries: ``(q, 2)``.
+            radius: m; ``inf`` lists every point.
+            exclude_self: the queries are the points themselves; drop ``i == j``.
+        """
+        q = np.ascontiguousarray(queries, dtype=np.float64).reshape(-1, 2)
+        n = self.points.shape[0]
+        if not math.isfinite(radius):
+            indptr, indices = _all_pairs(q.shape[0], n, exclude_self)
+            return Neighbors(indptr, indices, math.inf)
+        rings = max(1, math.ceil(radius / self.cell))
+        indptr, indices = _query(
+            self.points,
+            self.order,
+            self.starts,
+            self.origin[0],
+            self.origin[1],
+            self.cell,
+            self.shape[0],
+            self.shape[1],
+            q,
+            float(radius),
+            rings,
+            exclude_self,
+        )
+        return Neighbors(indptr, indices, float(radius))
+
+
+def find_neighbors(positions: FloatArray, cutoff: float) -> Neighbors:
+    """Pedestrian pairs closer than ``cutoff`` (self excluded), via a cell list."""
+    n = np.asarray(positions).reshape(-1, 2).shape[0]
+    if cutoff <= 0.0 or n < 2:
+        return Neighbors(np.zeros(n + 1, dtype=np.int64), np.zeros(0, dtype=np.int64), cutoff)
+    if not math.isfinite(cutoff):
+        n = np.asarray(positions).reshape(-1, 2).shape[0]
+        indptr, indices = _all_pairs(n, n, True)
+        return Neighbors(indptr, indices, math.inf)
+    # Half-cutoff cells scan 25 quarter-size cells (6.25 cutoff²) instead of 9 full ones (9).
+    return CellList(positions, 0.5 * cutoff).query(positions, cutoff, exclude_self=True)
+
+
+@njit(cache=True)
+def _build(
+    pts: FloatArray, ox: float, oy: float, cell: float, nx: int, ny: int
+) -> tuple[IntArray, IntArray]:
+    n = pts.shape[0]
+    cid = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        cx = min(max(int((pts[i, 0] - ox) / cell), 0), nx - 1)
+        cy = min(max(int((pts[i, 1] - oy) / cell), 0), ny - 1)
+        cid[i] = cy * nx + cx
+    order = np.argsort(cid, kind="mergesort")
+    starts = np.zeros(nx * ny + 1, dtype=np.int64)
+    for i in range(n):
+        starts[cid[i] + 1] += 1
+    for c in range(nx * ny):
+        starts[c + 1] += starts[c]
+    return order, starts
+
+
+@njit(cache=True)
+def _query(
+    pts: FloatArray,
+    order: IntArray,
+    starts: IntArray,
+    ox: float,
+    oy: float,
+    cell: float,
+    nx: int,
+    ny: int,
+    q: FloatArray,
+    radius: float,
+    rings: int,
+    exclude_self: bool,
+) -> tuple[IntArray, IntArray]:
+    nq = q.shape[0]
+    counts = np.zeros(nq + 1, dtype=np.int64)
+    # Two passes (count, then fill) keep memory exact without growing lists.
+    scratch = np.empty(0, dtype=np.int64)
+    for i in range(nq):
+        counts[i + 1] = counts[i] + _scan(
+            pts,
+            order,
+            starts,
+            ox,
+            oy,
+            cell,
+            nx,
+            ny,
+            q[i, 0],
+            q[i, 1],
+            radius,
+            rings,
+            i if exclude_self else -1,
+            scratch,
+            0,
+            False,
+        )
+    indices = np.empty(counts[nq], dtype=np.int64)
+    for i in range(nq):
+        _scan(
+            pts,
+            order,
+            starts,
+            ox,
+            oy,
+            cell,
+            nx,
+            ny,
+            q[i, 0],
+            q[i, 1],
+            radius,
+            rings,
+            i if exclude_self else -1,
+            indices,
+            counts[i],
+            True,
+        )
+    return counts, indices
+
+
+@njit(cache=True, inline="always")
+def _scan(
+    pts: FloatArray,
+    order: IntArray,
+    starts: IntArray,
+    ox: float,
+    oy: float,
+    cell: float,
+    nx: int,
+    ny: int,
+    x: float,
+    y: float,
+    radius: float,
+    rings: int,
+    skip: int,
+    out: IntArray,
+    offset: int,
+    write: bool,
+) -> int:
+    r2 = radius * radius
+    cx = int((x - ox) // cell)
+    cy = int((y - oy) // cell)
+    k = 0
+    for gy in range(max(cy - rings, 0), min(cy + rings, ny - 1) + 1):
+        row = gy * nx
+        for gx in range(max(cx - rings, 0), min(cx + rings, nx - 1) + 1):
+            c = row + gx
+            for s in range(starts[c], starts[c + 1]):
+                j = order[s]
+                if j == skip:
+                    continue
+                dx = pts[j, 0] - x
+                dy = pts[j, 1] - y
+                if dx * dx + dy * dy < r2:
+                    if write:
+                        out[offset + k] = j
+                    k += 1
+    return k
+
+
+@njit(cache=True)
+def _all_pairs(nq: int, n: int, exclude_self: bool) -> tuple[IntArray, IntArray]:
+    per = n - 1 if exclude_self else n
+    per = max(per, 0)
+    indptr = np.arange(nq + 1, dtype=np.int64) * per
+    indices = np.empty(nq * per, dtype=np.int64)
+    for i in range(nq):
+        k = i * per
+        for j in range(n):
+            if exclude_self and j == i:
+                continue
+            indices[k] = j
+            k += 1
+    return indptr, indices

@@ -1,0 +1,319 @@
+"""The crowd simulator: owns the pedestrians and moves them with a crowd model.
+
+It is the native2d backend's :class:`~arena.sim.backend.PedestrianDriver`. One step:
+
+1. start-up modes (``wait_timer``, ``trigger_zone``) release waiting agents;
+2. waypoints advance with Arena's tolerant switch (an agent within ``waypoint_tolerance`` of its
+   waypoint takes the next one at once, so it never circles its goal);
+3. destinations: own waypoint, or, for group members, the leader's waypoint offset on a ring
+   (Arena's group fix), then social states may redirect them (talking, interacting);
+4. the crowd model returns accelerations (or velocities) from one :class:`CrowdFrame`;
+5. social states post-process the accelerations (standing still, arriving gently);
+6. one integrator: ``v += a·dt``, hard cap ``|v| ≤ vmax·vmax_factor``, ``p += v·dt``, with
+   walls as hard constraints (:mod:`arena.crowd.integrator`).
+"""
+
+from __future__ import annotations
+
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field
+
+from arena.crowd.base import CROWD_MODELS, CrowdFrame, CrowdModel, RobotView
+from arena.crowd.integrator import integrate
+from arena.crowd.neighbors import find_neighbors
+from arena.crowd.state import CrowdState, StartupMode
+from arena.crowd.walls import WallIndex, world_segments
+from arena.maps.raster import polygon_mask
+from arena.sim.state import AgentStates, RobotStates, StaticWorld
+from arena.tasks.episode import WAYPOINT_RANDOM, AgentSpawn
+from arena.tasks.sampling import clearance_map
+
+FloatArray = NDArray[np.float64]
+
+
+class PedestrianConfig(BaseModel):
+    """How pedestrians behave beyond their motion model (the config's ``pedestrians:`` block)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    social_states: bool = Field(True, description="run Arena's human statechart")
+    initial_levels: Literal["arena", "random"] = Field(
+        "arena",
+        description="'arena': stress 0, energy and social 0.5 for everyone (Arena); 'random': "
+        "uniform in [0, 1] per agent, so a short episode already shows every social state",
+    )
+    waypoint_tolerance: float = Field(
+        0.5, gt=0, description="m, a waypoint counts as reached within this distance (Arena fix #2)"
+    )
+    group_fraction: float = Field(
+        0.3, ge=0, le=1, description="share of agents put into groups when the episode gives none"
+    )
+    max_group_size: int = Field(3, ge=2, description="largest group formed automatically")
+    group_radius: float = Field(3.0, gt=0, description="m, groups form among agents this close")
+    group_offset: float = Field(
+        0.5, ge=0, description="m, ring spacing of members around the leader's waypoint (Arena)"
+    )
+    wall_clearance: float = Field(
+        0.5,
+        ge=0,
+        le=1,
+        description="pedestrian centres keep this fraction of their radius "
+        "from walls (a hard constraint in the integrator)",
+    )
+    elder_speed_factor: float = Field(
+        0.7, gt=0, le=1, description="elders walk at this fraction of their vmax (pedsim)"
+    )
+
+
+class CrowdSimulator:
+    """Moves pedestrians with a registered crowd model; implements ``PedestrianDriver``.
+
+    Args:
+        model: the crowd model (an entry of :data:`~arena.crowd.base.CROWD_MODELS`).
+        config: pedestrian behaviour settings.
+    """
+
+    def __init__(self, model: CrowdModel, config: PedestrianConfig | None = None) -> None:
+        self.model = model
+        self.config = config or PedestrianConfig()
+        self.social: Any = None
+        self._state: CrowdState | None = None
+
+    @classmethod
+    def build(
+        cls, crowd: dict[str, Any] | str, pedestrians: PedestrianConfig | None = None
+    ) -> CrowdSimulator:
+        """Build from the config's ``crowd:`` block (the model) and ``pedestrians:`` block."""
+        return cls(CROWD_MODELS.build(crowd, path="crowd"), pedestrians)
+
+    @property
+    def state(self) -> CrowdState:
+        """The crowd's current state (read it, do not modify it)."""
+        if self._state is None:
+            raise RuntimeError("CrowdSimulator used before reset()")
+        return self._state
+
+    # -- PedestrianDriver -----------------------------------------------------------------------
+    def reset(self, spawn: AgentSpawn, world: StaticWorld, rng: np.random.Generator) -> AgentStates:
+        """Place the episode's pedestrians and prepare the model and social states."""
+        cfg = self.config
+        self._rng = rng
+        self._world = world
+        state = CrowdState.from_spawn(spawn)
+        elder = state.kinds == 1
+        state.vmax = np.where(elder, state.vmax * cfg.elder_speed_factor, state.vmax)
+        if spawn.groups is None and len(state) > 1 and cfg.group_fraction > 0:
+            from arena.crowd.state import leaders_of
+
+            state.group = form_groups(state.positions, cfg, rng)
+            state.leader = leaders_of(state.group)
+        self._walls_a, self._walls_b = world_segments(world)
+        self._wall_index = WallIndex(self._walls_a, self._walls_b)
+        # Distance from each cell to the nearest wall, obstacle or map edge, for the wall
+        # guard's fast path (agents far from everything skip the exact segment test).
+        grid = world.grid
+        blocked = grid.occupied
+        if world.obstacles:
+            blocked = blocked | polygon_mask(grid, [o.polygon for o in world.obstacles])
+        self._clearance = clearance_map(grid, blocked)
+        self._state = state
+        self._rows = np.arange(len(state))
+        self._members = np.flatnonzero(state.leader != self._rows)
+        rank = _member_rank(state.group, state.leader)
+        self._offsets = self._ring_offsets(rank[self._members], cfg.group_offset)
+        self.model.reset(state, world, rng)
+        if cfg.initial_levels == "random":
+            state.stress, state.energy, state.social = rng.random((3, len(state)))
+        if cfg.social_states:
+            from arena.crowd.social_states import SocialStates
+
+            self.social = SocialStates()
+            self.social.reset(state, world, rng)
+        self._update_destinations(np.zeros(0, dtype=bool))
+        return self._snapshot()
+
+    def step(self, robots: RobotStates, dt: float) -> AgentStates:
+        """Advance the crowd by ``dt`` seconds, seeing ``robots``."""
+        s = self.state
+        if len(s) == 0:
+            s.time += dt
+            return self._snapshot()
+        view = robot_view(robots)
+        self._start_up(view)
+        arrived = self._advance_waypoints()
+        self._update_destinations(arrived)
+        if self.social is not None:
+            self.social.pre(s, view, self._world, dt)
+        active = s.started.copy()
+        neighbors = find_neighbors(s.positions, self.model.neighbor_cutoff())
+        frame = CrowdFrame(
+            state=s,
+            destinations=s.destinations.copy(),
+            active=active,
+            robots=view,
+            walls_a=self._walls_a,
+            walls_b=self._walls_b,
+            neighbors=neighbors,
+            dt=dt,
+            rng=self._rng,
+        )
+        out = self.model.compute(frame)
+        if self.model.output == "velocity":
+            if out.velocities is None:
+                raise RuntimeError(f"{type(self.model).__name__} returned no velocities")
+            update = np.asarray(out.velocities, dtype=np.float64)
+            if self.social is not None:
+                # Only for its vmax-factor side effects (arriving, standing): the cap in the
+                # integrator then stops velocity models too.
+                self.social.post(s, np.zeros_like(update), dt)
+        else:
+            if out.accelerations is None:
+                raise RuntimeError(f"{type(self.model).__name__} returned no accelerations")
+            update = np.asarray(out.accelerations, dtype=np.float64)
+            if self.social is not None:
+                update = self.social.post(s, update, dt)
+        grid = self._world.grid
+        s.positions, v = integrate(
+            self._wall_index,
+            self._clearance,
+            grid.origin,
+            grid.resolution,
+            s.positions,
+            s.velocities,
+            update,
+            self.model.output == "velocity",
+            active,
+            s.vmax * s.vmax_factor,  # after post: it may lower the factors
+            self.config.wall_clearance * s.radii,
+            dt,
+        )
+        s.velocities = v
+        moving = np.hypot(v[:, 0], v[:, 1]) > 1e-3
+        s.headings = np.where(moving, np.arctan2(v[:, 1], v[:, 0]), s.headings)
+        if self.social is not None:
+            self.social.orient(s)
+        s.forces = out.forces
+        s.time += dt
+        return self._snapshot()
+
+    # -- steps ----------------------------------------------------------------------------------
+    def _start_up(self, robots: RobotView) -> None:
+        s = self.state
+        waiting = ~s.started
+        if not waiting.any():
+            return
+        timer = waiting & (s.startup_mode == StartupMode.WAIT_TIMER) & (s.time >= s.wait_time)
+        trigger = np.zeros_like(waiting)
+        zone = waiting & (s.startup_mode == StartupMode.TRIGGER_ZONE)
+        if zone.any() and len(robots):
+            d = np.hypot(
+                *(s.positions[zone, None, :] - robots.positions[None, :, :]).transpose(2, 0, 1)
+            )
+            trigger[zone] = np.any(d <= s.trigger_radius[zone, None], axis=1)
+        s.started = s.started | timer | trigger
+
+    def _advance_waypoints(self) -> NDArray[np.bool_]:
+        """Tolerant switch: leaders and loners within tolerance of their waypoint take the next."""
+        s = self.state
+        own = s.leader == self._rows
+        target = s.waypoints[self._rows, s.waypoint_index]
+        tol = np.maximum(self.config.waypoint_tolerance, s.radii)
+        arrived = own & s.started & (np.hypot(*(s.positions - target).T) < tol)
+        if arrived.any():
+            nwp = s.num_waypoints
+            nxt = (s.waypoint_index + 1) % nwp
+            rand = arrived & (s.waypoint_mode == WAYPOINT_RANDOM) & (nwp > 1)
+            if rand.any():
+                shift = self._rng.integers(1, nwp[rand])
+                nxt[rand] = (s.waypoint_index[rand] + shift) % nwp[rand]
+            s.waypoint_index = np.where(arrived, nxt, s.waypoint_index)
+        return arrived
+
+    def _update_destinations(self, arrived: NDArray[np.bool_]) -> None:
+        """Own waypoint for leaders and loners; the leader's, offset on a ring, for members."""
+        s = self.state
+        wp = s.waypoints[self._rows, s.waypoint_index]
+        if self._members.size:
+            wp[self._members] = wp[s.leader[self._members]] + self._offsets
+        s.destinations = wp
+
+    @staticmethod
+    def _ring_offsets(rank: NDArray[np.int64], spacing: float) -> FloatArray:
+        """Slots around the leader's waypoint: ring i holds 6·i members at radius i·spacing."""
+        ring = np.maximum(np.ceil((np.sqrt(1 + 4 * rank / 3) - 1) / 2).astype(np.int64), 1)
+        slot = rank - (3 * ring * (ring - 1) + 1)
+        angle = 2 * np.pi * slot / (6 * ring)
+        r = ring * spacing
+        return np.stack([r * np.cos(angle), r * np.sin(angle)], axis=1)
+
+    def _snapshot(self) -> AgentStates:
+        s = self.state
+        return AgentStates(
+            ids=s.ids.copy(),
+            positions=s.positions.copy(),
+            velocities=s.velocities.copy(),
+            headings=s.headings.copy(),
+            radii=s.radii.copy(),
+            kinds=s.kinds.copy(),
+            states=s.social_state.copy(),
+        )
+
+
+def robot_view(robots: RobotStates) -> RobotView:
+    """Robots as pedestrians perceive them: world-frame positions and velocities."""
+    if len(robots) == 0:
+        return RobotView.empty()
+    th = robots.poses[:, 2]
+    c, s = np.cos(th), np.sin(th)
+    vx, vy = robots.twists[:, 0], robots.twists[:, 1]
+    vel = np.stack([c * vx - s * vy, s * vx + c * vy], axis=1)
+    return RobotView(robots.poses[:, :2].copy(), th.copy(), vel, robots.radii.copy())
+
+
+def form_groups(
+    positions: FloatArray, cfg: PedestrianConfig, rng: np.random.Generator
+) -> NDArray[np.int64]:
+    """Group ids (-1 alone): random seeds pull their nearest ungrouped neighbours in.
+
+    About ``group_fraction`` of the agents end up in groups of 2..``max_group_size``, formed
+    among agents within ``group_radius`` of the group's first member (people who walk together
+    start together). Runs once per episode.
+    """
+    n = positions.shape[0]
+    groups = np.full(n, -1, dtype=np.int64)
+    target = round(cfg.group_fraction * n)
+    near = find_neighbors(positions, cfg.group_radius)
+    placed, gid = 0, 0
+    for i in rng.permutation(n):  # once per episode, over group seeds only
+        if placed >= target:
+            break
+        if groups[i] >= 0:
+            continue
+        cand = near.of(int(i))
+        cand = cand[groups[cand] < 0]
+        if cand.size == 0:
+            continue
+        size = int(rng.integers(2, cfg.max_group_size + 1))
+        dist = np.hypot(*(positions[cand] - positions[i]).T)
+        take = cand[np.lexsort((cand, dist))[: size - 1]]
+        groups[i] = gid
+        groups[take] = gid
+        placed += 1 + take.size
+        gid += 1
+    return groups
+
+
+def _member_rank(group: NDArray[np.int64], leader: NDArray[np.int64]) -> NDArray[np.int64]:
+    """0 for leaders and loners; 1, 2, … for the members of each group in index order."""
+    n = group.shape[0]
+    rank = np.zeros(n, dtype=np.int64)
+    members = np.flatnonzero(leader != np.arange(n))
+    if members.size:
+        order = members[np.argsort(group[members], kind="stable")]
+        g = group[order]
+        start = np.r_[0, np.flatnonzero(np.diff(g)) + 1]
+        counts = np.diff(np.r_[start, g.size])
+        rank[order] = np.arange(g.size) - np.repeat(start, counts) + 1
+    return rank

@@ -1,0 +1,169 @@
+"""Crowd step time for every registered crowd model at 10, 100 and 1,000 agents, with walls.
+
+    python benchmarks/crowd_step.py [--sizes 10 100 1000] [--steps 50]
+
+World: a 40 x 40 m hall with outer walls, two interior walls with doors and 12 pillars.
+Agents start at random free positions and walk loops between two random waypoints. Timed: one
+``CrowdSimulator.step`` (neighbour search, model, integrator with the wall guard), social states
+off so the figure is the model's cost; one core. References in the same run when installed:
+PyPI ``pysocialforce`` (``Simulator.step``) and ``pyrvo`` (RVO2 C++, ``do_step``; preferred
+velocities set before the timer, as our figure includes computing them).
+"""
+
+from __future__ import annotations
+
+import os
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(var, "1")
+
+import argparse  # noqa: E402
+import logging  # noqa: E402
+import tempfile  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+import arena.crowd  # noqa: E402, F401
+from arena.crowd.base import CROWD_MODELS  # noqa: E402
+from arena.crowd.simulator import CrowdSimulator, PedestrianConfig  # noqa: E402
+from arena.crowd.walls import world_segments  # noqa: E402
+from arena.maps.grid import OccupancyGrid  # noqa: E402
+from arena.sim.state import RobotStates, StaticWorld  # noqa: E402
+from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn  # noqa: E402
+
+RES = 0.1
+
+
+def hall() -> StaticWorld:
+    """40 x 40 m with walls, two interior walls with 3 m doors, 12 pillars."""
+    n = round(40 / RES)
+    occ = np.zeros((n, n), dtype=bool)
+    occ[:3, :] = occ[-3:, :] = occ[:, :3] = occ[:, -3:] = True
+    occ[130:133, :] = True
+    occ[130:133, 80:110] = occ[130:133, 290:320] = False
+    occ[270:273, :] = True
+    occ[270:273, 180:210] = False
+    for i in range(4):
+        for j in range(3):
+            y, x = 60 + 90 * j + 20, 60 + 90 * i
+            occ[y : y + 6, x : x + 6] = True
+    return StaticWorld.build(OccupancyGrid.from_occupied(occ, RES))
+
+
+def spawn(world: StaticWorld, n: int, seed: int = 0) -> AgentSpawn:
+    """``n`` agents at free positions (0.5 m from walls), two random waypoints each."""
+    rng = np.random.default_rng(seed)
+    free = np.argwhere(world.grid.distance > 0.5)
+    pick = free[rng.choice(len(free), size=3 * n, replace=False)]
+    pts = world.grid.cell_to_world(pick).reshape(n, 3, 2)
+    return AgentSpawn(
+        positions=pts[:, 0], radii=np.full(n, 0.3), vmax=rng.uniform(0.8, 1.4, n),
+        waypoints=pts[:, 1:], num_waypoints=np.full(n, 2), waypoint_mode=np.full(n, WAYPOINT_LOOP),
+        kinds=np.zeros(n, dtype=np.int64), groups=np.full(n, -1, dtype=np.int64),
+    )
+
+
+NO_ROBOTS = RobotStates(
+    ("r",), ("burger",), np.array([[-100.0, -100.0, 0.0]]), np.zeros((1, 3)), np.zeros((1, 3)),
+    np.array([0.2]), (None,), (np.zeros(0),),
+)
+
+
+def time_model(name: str, world: StaticWorld, n: int, steps: int) -> float:
+    """ms per CrowdSimulator step."""
+    sim = CrowdSimulator(CROWD_MODELS.build(name), PedestrianConfig(social_states=False))
+    sim.reset(spawn(world, n), world, np.random.default_rng(1))
+    for _ in range(3):  # warm-up: JIT and caches
+        sim.step(NO_ROBOTS, 0.1)
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        sim.step(NO_ROBOTS, 0.1)
+    return 1e3 * (time.perf_counter() - t0) / steps
+
+
+def time_pysocialforce(world: StaticWorld, n: int, steps: int) -> float | None:
+    """ms per ``pysocialforce.Simulator.step`` on the same scene, or None if not installed."""
+    # Importing pysocialforce sets the root logger to DEBUG and opens ./file.log: do it in a
+    # scratch folder and restore the logging level.
+    level = logging.getLogger().level
+    cwd = os.getcwd()
+    with tempfile.TemporaryDirectory() as tmp:
+        os.chdir(tmp)
+        try:
+            import pysocialforce as psf
+        except ImportError:
+            return None
+        finally:
+            os.chdir(cwd)
+            logging.getLogger().setLevel(level)
+            for h in list(logging.getLogger().handlers):
+                if isinstance(h, logging.FileHandler):
+                    logging.getLogger().removeHandler(h)
+                    h.close()
+    sp = spawn(world, n)
+    state = np.zeros((n, 6))
+    state[:, :2] = sp.positions
+    state[:, 4:6] = sp.waypoints[:, 0]
+    a, b = world_segments(world)
+    obstacles = [(p[0], q[0], p[1], q[1]) for p, q in zip(a, b, strict=True)]
+    sim = psf.Simulator(state, obstacles=obstacles)
+    sim.step(1)
+    t0 = time.perf_counter()
+    sim.step(steps)
+    return 1e3 * (time.perf_counter() - t0) / steps
+
+
+def time_pyrvo(world: StaticWorld, n: int, steps: int) -> float | None:
+    """ms per RVO2 ``do_step`` (C++) on the same scene, or None if not installed."""
+    try:
+        import pyrvo
+    except ImportError:
+        return None
+    sp = spawn(world, n)
+    sim = pyrvo.RVOSimulator()
+    sim.set_time_step(0.1)
+    sim.set_agent_defaults(2.0, 10, 5.0, 2.0, 0.3, 1.4, (0.0, 0.0))
+    for p in sp.positions:
+        sim.add_agent((float(p[0]), float(p[1])))
+    a, b = world_segments(world)
+    for p, q in zip(a, b, strict=True):
+        sim.add_obstacle([(float(p[0]), float(p[1])), (float(q[0]), float(q[1]))])
+    sim.process_obstacles()
+    total = 0.0
+    for _ in range(steps + 1):
+        for i in range(n):  # preferred velocities: not timed (a Python loop in the binding)
+            pos = np.array(sim.get_agent_position(i).to_tuple())
+            d = sp.waypoints[i, 0] - pos
+            norm = float(np.hypot(*d))
+            v = d / norm * sp.vmax[i] if norm > 1e-9 else d
+            sim.set_agent_pref_velocity(i, (float(v[0]), float(v[1])))
+        t0 = time.perf_counter()
+        sim.do_step()
+        total += time.perf_counter() - t0
+    return 1e3 * total / (steps + 1)
+
+
+def main() -> None:
+    """Print the table."""
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--sizes", type=int, nargs="+", default=[10, 100, 1000])
+    ap.add_argument("--steps", type=int, default=50)
+    ap.add_argument("--models", nargs="*", default=None)
+    args = ap.parse_args()
+    world = hall()
+    names = args.models or CROWD_MODELS.names()
+    print(f"crowd step, ms per step (1 core; 40 x 40 m hall with walls; {args.steps} steps)")
+    print(f"{'model':<22}" + "".join(f"{n:>12,d}" for n in args.sizes))
+    for name in names:
+        row = [time_model(name, world, n, args.steps) for n in args.sizes]
+        print(f"{name:<22}" + "".join(f"{v:12.3f}" for v in row))
+    for label, fn in (("ref: pysocialforce", time_pysocialforce), ("ref: pyrvo (C++)", time_pyrvo)):
+        vals = [fn(world, n, max(3, args.steps // 5) if n >= 1000 else args.steps)
+                for n in args.sizes]
+        cells = "".join("   (missing)" if v is None else f"{v:12.3f}" for v in vals)
+        print(f"{label:<22}{cells}")
+
+
+if __name__ == "__main__":
+    main()

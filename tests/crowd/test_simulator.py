@@ -1,0 +1,224 @@
+import numpy as np
+import pytest
+
+from arena.crowd.integrator import guard_walls
+from arena.crowd.models.walker import WaypointWalker
+from arena.crowd.simulator import CrowdSimulator, PedestrianConfig, form_groups, robot_view
+from arena.crowd.state import SocialState, StartupMode
+from arena.crowd.walls import WallIndex, grid_wall_segments
+from arena.maps.grid import OccupancyGrid
+from arena.sim.state import RobotStates, StaticWorld
+from arena.tasks.episode import WAYPOINT_LOOP, WAYPOINT_RANDOM, AgentSpawn
+
+WORLD = StaticWorld.build(OccupancyGrid.empty(20, 20, 0.1))
+NO_ROBOTS = RobotStates(
+    (), (), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), (), ()
+)
+PLAIN = PedestrianConfig(social_states=False, group_fraction=0.0)
+
+
+def robots_at(xy, twist=(0.0, 0.0, 0.0), theta=0.0):
+    return RobotStates(
+        ("r",),
+        ("burger",),
+        np.array([[*xy, theta]]),
+        np.array([twist]),
+        np.zeros((1, 3)),
+        np.array([0.2]),
+        (None,),
+        (np.zeros(0),),
+    )
+
+
+def spawn(mode=WAYPOINT_LOOP, n=4, k=3, seed=0, **extra):
+    rng = np.random.default_rng(seed)
+    return AgentSpawn(
+        positions=rng.uniform(3, 17, (n, 2)),
+        radii=np.full(n, 0.3),
+        vmax=rng.uniform(0.5, 1.5, n),
+        waypoints=rng.uniform(3, 17, (n, k, 2)),
+        num_waypoints=np.full(n, k),
+        waypoint_mode=np.full(n, mode),
+        kinds=np.zeros(n, dtype=np.int64),
+        **extra,
+    )
+
+
+def run(sp, steps=400, seed=1, dt=0.1, config=PLAIN, robots=NO_ROBOTS, model=None):
+    sim = CrowdSimulator(model or WaypointWalker(), config)
+    states = [sim.reset(sp, WORLD, np.random.default_rng(seed))]
+    for _ in range(steps):
+        states.append(sim.step(robots, dt))
+    return sim, states
+
+
+def test_speed_capped_and_acceleration_bounded():
+    sp = spawn()
+    _, states = run(sp)
+    v = np.array([s.velocities for s in states])
+    assert np.all(np.linalg.norm(v, axis=2) <= sp.vmax + 1e-9)
+    acc = np.linalg.norm(np.diff(v, axis=0), axis=2) / 0.1
+    assert np.all(acc <= WaypointWalker.Params().max_acceleration + 1e-6)
+
+
+def test_loop_mode_visits_waypoints_in_order_with_tolerant_switch():
+    sp = spawn(n=1, k=3)
+    _, states = run(sp, steps=2000)
+    pos = np.array([s.positions[0] for s in states])
+    visits = []
+    for p in pos:
+        d = np.linalg.norm(sp.waypoints[0] - p, axis=1)
+        j = int(np.argmin(d))
+        if d[j] < PLAIN.waypoint_tolerance + 0.05 and (not visits or visits[-1] != j):
+            visits.append(j)
+    assert visits[:6] == [0, 1, 2, 0, 1, 2]
+    # The tolerant switch means the agent never stops at or circles its waypoint: it keeps
+    # walking (only slowing in sharp turns) at its preferred speed most of the time.
+    speeds = np.linalg.norm([s.velocities[0] for s in states[50:]], axis=1)
+    assert speeds.min() > 0.03
+    assert np.median(speeds) == pytest.approx(sp.vmax[0], rel=1e-6)
+
+
+def test_random_mode_deterministic_per_seed():
+    sp = spawn(WAYPOINT_RANDOM, n=6, k=4)
+    _, a = run(sp, seed=5)
+    _, b = run(sp, seed=5)
+    _, c = run(sp, seed=6)
+    assert all(np.array_equal(x.positions, y.positions) for x, y in zip(a, b, strict=True))
+    assert not all(np.array_equal(x.positions, y.positions) for x, y in zip(a, c, strict=True))
+
+
+def test_startup_modes():
+    n = 3
+    sp = spawn(
+        n=n,
+        startup_mode=np.array(
+            [StartupMode.DEFAULT, StartupMode.WAIT_TIMER, StartupMode.TRIGGER_ZONE]
+        ),
+        wait_time=np.array([0.0, 2.0, 0.0]),
+        trigger_radius=np.array([0.0, 0.0, 2.0]),
+    )
+    # A robot far from agent 2 first.
+    far = robots_at((-50.0, -50.0))
+    _, states = run(sp, steps=40, robots=far)
+    moved = [np.linalg.norm(states[k].positions - sp.positions, axis=1) for k in (15, 40)]
+    assert moved[0][0] > 0.1  # default: at once
+    assert moved[0][1] == 0.0 and moved[1][1] > 0.1  # timer: after 2 s
+    assert moved[1][2] == 0.0  # trigger zone: robot never came
+    near = robots_at(tuple(sp.positions[2] + [1.0, 0.0]))
+    _, states = run(sp, steps=5, robots=near)
+    assert np.linalg.norm(states[-1].positions[2] - sp.positions[2]) > 0.0
+
+
+def test_group_members_head_for_the_leaders_waypoint():
+    sp = spawn(n=3, k=2, groups=np.array([0, 0, -1]))
+    sim, states = run(sp, steps=300)
+    s = sim.state
+    assert s.leader.tolist() == [0, 0, 2]
+    lead_wp = s.current_waypoints[0]
+    d = np.linalg.norm(s.destinations[1] - lead_wp)
+    assert d == pytest.approx(PLAIN.group_offset)
+    assert np.linalg.norm(states[-1].positions[1] - states[-1].positions[0]) < 3.0
+
+
+def test_form_groups():
+    rng = np.random.default_rng(0)
+    pos = rng.uniform(0, 10, (40, 2))
+    cfg = PedestrianConfig(group_fraction=0.5, max_group_size=3, group_radius=3.0)
+    g = form_groups(pos, cfg, np.random.default_rng(1))
+    assert np.array_equal(g, form_groups(pos, cfg, np.random.default_rng(1)))
+    ids, counts = np.unique(g[g >= 0], return_counts=True)
+    assert counts.min() >= 2 and counts.max() <= 3
+    assert 0.4 * 40 <= (g >= 0).sum() <= 0.5 * 40 + 2
+    for gid in ids:  # members within the group radius of each other's seed
+        m = pos[g == gid]
+        assert np.max(np.linalg.norm(m[:, None] - m[None], axis=2)) < 2 * cfg.group_radius
+
+
+def test_elders_walk_slower_and_states_reported():
+    sp = spawn(n=2)
+    sp = AgentSpawn(
+        sp.positions,
+        sp.radii,
+        np.array([1.0, 1.0]),
+        sp.waypoints,
+        sp.num_waypoints,
+        sp.waypoint_mode,
+        np.array([0, 1]),
+    )
+    sim, states = run(sp, steps=5)
+    assert sim.state.vmax.tolist() == [1.0, pytest.approx(0.7)]
+    assert np.all(states[-1].states == SocialState.WALKING)
+
+
+def test_robot_view_world_velocity():
+    v = robot_view(robots_at((1.0, 2.0), twist=(1.0, 0.5, 0.0), theta=np.pi / 2))
+    assert np.allclose(v.velocities[0], [-0.5, 1.0])
+    assert np.allclose(v.positions[0], [1.0, 2.0])
+
+
+def test_wall_guard_never_crosses_and_keeps_clearance():
+    grid = OccupancyGrid.empty(10, 10, 0.1)
+    idx = WallIndex(*grid_wall_segments(grid))
+    rng = np.random.default_rng(3)
+    p0 = rng.uniform(1, 9, (500, 2))
+    p1 = p0 + rng.normal(0, 4.0, (500, 2))  # wild moves, many through the outer walls
+    out = guard_walls(idx, p0, p1, np.full(500, 0.15))
+    lo, hi = 0.1 + 0.15 - 1e-9, 9.9 - 0.15 + 1e-9
+    assert np.all((out >= lo) & (out <= hi))
+    inside = np.all((p1 > 0.25) & (p1 < 9.75), axis=1)
+    assert np.allclose(out[inside], p1[inside])  # moves that stay clear are untouched
+
+
+def test_inputs_not_mutated():
+    sp = spawn()
+    before = (sp.positions.copy(), sp.waypoints.copy())
+    run(sp, steps=20)
+    assert np.array_equal(sp.positions, before[0]) and np.array_equal(sp.waypoints, before[1])
+
+
+def test_compiled_integrator_matches_guard_reference():
+    from arena.crowd.integrator import integrate
+    from arena.tasks.sampling import clearance_map
+
+    occ = np.zeros((100, 100), dtype=bool)
+    occ[:, 50] = True  # a thin wall through the middle
+    occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    grid = OccupancyGrid.from_occupied(occ, 0.1)
+    a, b = grid_wall_segments(grid)
+    idx = WallIndex(a, b)
+    rng = np.random.default_rng(7)
+    n = 400
+    p0 = rng.uniform(0.5, 9.5, (n, 2))
+    p0 = p0[~grid.is_occupied(p0) & (np.abs(p0[:, 0] - 5.05) > 0.3)]
+    n = len(p0)
+    acc = rng.normal(0, 30.0, (n, 2))
+    vel = rng.normal(0, 1.0, (n, 2))
+    vmax = np.full(n, 2.0)
+    clear = np.full(n, 0.15)
+    dt = 0.5
+    active = rng.random(n) < 0.9
+    new_p, new_v = integrate(
+        idx,
+        clearance_map(grid),
+        grid.origin,
+        grid.resolution,
+        p0,
+        vel,
+        acc,
+        False,
+        active,
+        vmax,
+        clear,
+        dt,
+    )
+    v = vel + acc * dt
+    v[~active] = 0
+    sp = np.hypot(*v.T)
+    v *= np.minimum(1.0, vmax / np.maximum(sp, 1e-12))[:, None]
+    ref = guard_walls(idx, p0, p0 + v * dt, clear)
+    assert np.allclose(new_p, ref, atol=1e-12)
+    assert np.allclose(new_v, (ref - p0) / dt, atol=1e-12)
+    # Nobody changed side of the middle wall.
+    assert np.array_equal(new_p[:, 0] < 5.0, p0[:, 0] < 5.0)
+    assert np.all(np.hypot(*new_v.T) <= vmax * (1 + 1e-9) + 1e-9)
