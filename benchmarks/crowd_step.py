@@ -58,28 +58,50 @@ def spawn(world: StaticWorld, n: int, seed: int = 0) -> AgentSpawn:
     pick = free[rng.choice(len(free), size=3 * n, replace=False)]
     pts = world.grid.cell_to_world(pick).reshape(n, 3, 2)
     return AgentSpawn(
-        positions=pts[:, 0], radii=np.full(n, 0.3), vmax=rng.uniform(0.8, 1.4, n),
-        waypoints=pts[:, 1:], num_waypoints=np.full(n, 2), waypoint_mode=np.full(n, WAYPOINT_LOOP),
-        kinds=np.zeros(n, dtype=np.int64), groups=np.full(n, -1, dtype=np.int64),
+        positions=pts[:, 0],
+        radii=np.full(n, 0.3),
+        vmax=rng.uniform(0.8, 1.4, n),
+        waypoints=pts[:, 1:],
+        num_waypoints=np.full(n, 2),
+        waypoint_mode=np.full(n, WAYPOINT_LOOP),
+        kinds=np.zeros(n, dtype=np.int64),
+        groups=np.full(n, -1, dtype=np.int64),
     )
 
 
 NO_ROBOTS = RobotStates(
-    ("r",), ("burger",), np.array([[-100.0, -100.0, 0.0]]), np.zeros((1, 3)), np.zeros((1, 3)),
-    np.array([0.2]), (None,), (np.zeros(0),),
+    ("r",),
+    ("burger",),
+    np.array([[-100.0, -100.0, 0.0]]),
+    np.zeros((1, 3)),
+    np.zeros((1, 3)),
+    np.array([0.2]),
+    (None,),
+    (np.zeros(0),),
 )
 
 
-def time_model(name: str, world: StaticWorld, n: int, steps: int) -> float:
-    """ms per CrowdSimulator step."""
+def time_model(name: str, world: StaticWorld, n: int, steps: int) -> tuple[float, float]:
+    """ms per CrowdSimulator step, and ms of it spent in the model's ``compute``."""
     sim = CrowdSimulator(CROWD_MODELS.build(name), PedestrianConfig(social_states=False))
     sim.reset(spawn(world, n), world, np.random.default_rng(1))
     for _ in range(3):  # warm-up: JIT and caches
         sim.step(NO_ROBOTS, 0.1)
+    inner = sim.model.compute
+    spent = [0.0]
+
+    def timed(frame):
+        t = time.perf_counter()
+        out = inner(frame)
+        spent[0] += time.perf_counter() - t
+        return out
+
+    sim.model.compute = timed
     t0 = time.perf_counter()
     for _ in range(steps):
         sim.step(NO_ROBOTS, 0.1)
-    return 1e3 * (time.perf_counter() - t0) / steps
+    total = time.perf_counter() - t0
+    return 1e3 * total / steps, 1e3 * spent[0] / steps
 
 
 def time_pysocialforce(world: StaticWorld, n: int, steps: int) -> float | None:
@@ -90,11 +112,13 @@ def time_pysocialforce(world: StaticWorld, n: int, steps: int) -> float | None:
     cwd = os.getcwd()
     with tempfile.TemporaryDirectory() as tmp:
         os.chdir(tmp)
+        logging.disable(logging.CRITICAL)  # its import logs matplotlib's start-up at DEBUG
         try:
             import pysocialforce as psf
         except ImportError:
             return None
         finally:
+            logging.disable(logging.NOTSET)
             os.chdir(cwd)
             logging.getLogger().setLevel(level)
             for h in list(logging.getLogger().handlers):
@@ -154,15 +178,21 @@ def main() -> None:
     world = hall()
     names = args.models or CROWD_MODELS.names()
     print(f"crowd step, ms per step (1 core; 40 x 40 m hall with walls; {args.steps} steps)")
-    print(f"{'model':<22}" + "".join(f"{n:>12,d}" for n in args.sizes))
+    print("full = CrowdSimulator.step (neighbour search + model + integrator with wall guard);")
+    print("model = the model's compute() alone")
+    head = "".join(f"{f'full {n:,d}':>13}{f'model {n:,d}':>13}" for n in args.sizes)
+    print(f"{'model':<20}{head}")
     for name in names:
         row = [time_model(name, world, n, args.steps) for n in args.sizes]
-        print(f"{name:<22}" + "".join(f"{v:12.3f}" for v in row))
+        print(f"{name:<20}" + "".join(f"{full:13.3f}{model:13.3f}" for full, model in row))
     for label, fn in (("ref: pysocialforce", time_pysocialforce), ("ref: pyrvo (C++)", time_pyrvo)):
-        vals = [fn(world, n, max(3, args.steps // 5) if n >= 1000 else args.steps)
-                for n in args.sizes]
-        cells = "".join("   (missing)" if v is None else f"{v:12.3f}" for v in vals)
-        print(f"{label:<22}{cells}")
+        vals = [
+            fn(world, n, max(3, args.steps // 5) if n >= 1000 else args.steps) for n in args.sizes
+        ]
+        cells = "".join(
+            f"{'(missing)':>13}{'':13}" if v is None else f"{v:13.3f}{'':13}" for v in vals
+        )
+        print(f"{label:<20}{cells}")
 
 
 if __name__ == "__main__":

@@ -7,9 +7,11 @@ acceleration. No pedestrian, wall or robot term.
 
 from __future__ import annotations
 
+import math
 from typing import ClassVar, Literal
 
 import numpy as np
+from numba import njit
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
@@ -42,12 +44,36 @@ class WaypointWalker:
     def compute(self, frame: CrowdFrame) -> ModelOutput:
         """Acceleration toward the desired velocity, limited to ``max_acceleration``."""
         s = frame.state
-        delta = frame.destinations - s.positions
-        dist = np.hypot(delta[:, 0], delta[:, 1])[:, None]
-        speed = np.minimum((s.vmax * s.vmax_factor)[:, None], dist / max(frame.dt, 1e-9))
-        desired = np.divide(delta, dist, out=np.zeros_like(delta), where=dist > 1e-9) * speed
-        acc = (desired - s.velocities) / frame.dt
-        norm = np.hypot(acc[:, 0], acc[:, 1])[:, None]
-        acc *= np.minimum(1.0, self.params.max_acceleration / np.maximum(norm, 1e-12))
-        acc[~frame.active] = 0.0
-        return ModelOutput(accelerations=acc, forces={"desired": acc.copy()})
+        acc = _walk(
+            s.positions,
+            s.velocities,
+            frame.destinations,
+            s.vmax * s.vmax_factor,
+            frame.active,
+            self.params.max_acceleration,
+            frame.dt,
+        )
+        return ModelOutput(accelerations=acc, forces={"desired": acc})
+
+
+@njit(cache=True)
+def _walk(pos, vel, dest, vmax, active, max_acc, dt):
+    """Desired velocity toward the destination, reached within ``max_acc``.
+
+    The speed drops on the last stretch so the agent stops on its destination; inactive agents
+    get zero.
+    """
+    n = pos.shape[0]
+    acc = np.zeros((n, 2))
+    for i in range(n):
+        if not active[i]:
+            continue
+        dx, dy = dest[i, 0] - pos[i, 0], dest[i, 1] - pos[i, 1]
+        dist = math.sqrt(dx * dx + dy * dy)
+        speed = min(vmax[i], dist / max(dt, 1e-9))
+        ux, uy = (dx / dist * speed, dy / dist * speed) if dist > 1e-9 else (0.0, 0.0)
+        ax, ay = (ux - vel[i, 0]) / dt, (uy - vel[i, 1]) / dt
+        norm = math.sqrt(ax * ax + ay * ay)
+        k = min(1.0, max_acc / max(norm, 1e-12))
+        acc[i, 0], acc[i, 1] = ax * k, ay * k
+    return acc

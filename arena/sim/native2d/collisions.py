@@ -142,8 +142,19 @@ def first_agent_hit(
     """Index of the nearest pedestrian circle the footprint overlaps, or -1."""
     if positions.shape[0] == 0:
         return -1
-    poly = _EMPTY_POLY if fp.polygon is None else transform_points(fp.polygon, pose)
+    poly = _EMPTY_POLY if fp.polygon is None else _place(fp.polygon, pose)
     return int(_agent_hit_kernel(float(pose[0]), float(pose[1]), fp.radius, poly, positions, radii))
+
+
+@njit(cache=True)
+def _place(polygon: NDArray[np.float64], pose: NDArray[np.float64]) -> NDArray[np.float64]:
+    """:func:`transform_points` for one pose, compiled (hot path: once per robot and step)."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    out = np.empty_like(polygon)
+    for k in range(polygon.shape[0]):
+        out[k, 0] = pose[0] + c * polygon[k, 0] - s * polygon[k, 1]
+        out[k, 1] = pose[1] + s * polygon[k, 0] + c * polygon[k, 1]
+    return out
 
 
 _EMPTY_POLY = np.zeros((0, 2))
