@@ -3,9 +3,11 @@
 import json
 
 import numpy as np
+import pytest
 
 from arena.config import load_config
 from arena.core.types import Outcome
+from arena.crowd.base import CROWD_MODELS
 from arena.experiment import make_episode, run_episode, run_experiment
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
@@ -72,3 +74,24 @@ def test_timeout(tmp_path):
     _, (res,) = run_experiment(cfg, tmp_path)
     assert res.outcome == Outcome.TIMEOUT
     assert abs(res.time - 2.0) < 1e-6
+
+
+@pytest.mark.parametrize("model", sorted(CROWD_MODELS.names()))
+def test_every_crowd_model_runs_an_episode(model, tmp_path):
+    cfg = load_config(
+        None,
+        [
+            f"crowd.type={model}",
+            "task.agents=8",
+            "task.obstacles=1",
+            "task.time_limit=6",
+            "output.video=false",
+            "pedestrians.initial_levels=random",
+        ],
+    )
+    _, (res,) = run_experiment(cfg, tmp_path)
+    assert res.outcome in {o.value for o in Outcome}
+    assert res.outcome != Outcome.ERROR, res.error
+    agents = np.loadtxt(tmp_path / "episode_000" / "agents.csv", delimiter=",", skiprows=1)
+    assert agents.shape[0] == 8 * (res.steps + 1)
+    assert np.all(np.isfinite(agents))

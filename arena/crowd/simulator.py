@@ -56,11 +56,11 @@ class PedestrianConfig(BaseModel):
         0.5, ge=0, description="m, ring spacing of members around the leader's waypoint (Arena)"
     )
     wall_clearance: float = Field(
-        0.5,
+        1.0,
         ge=0,
         le=1,
         description="pedestrian centres keep this fraction of their radius "
-        "from walls (a hard constraint in the integrator)",
+        "from walls, a hard constraint in the integrator (1: bodies never overlap walls)",
     )
     elder_speed_factor: float = Field(
         0.7, gt=0, le=1, description="elders walk at this fraction of their vmax (pedsim)"
