@@ -127,7 +127,7 @@ class CrowdSimulator:
         if cfg.initial_levels == "random":
             state.stress, state.energy, state.social = rng.random((3, len(state)))
         if cfg.social_states:
-            from arena.crowd.social_states import SocialStates
+            from arena.crowd.social import SocialStates
 
             self.social = SocialStates()
             self.social.reset(state, world, rng)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from arena.crowd.base import RobotView
-from arena.crowd.social_states import (
+from arena.crowd.social import (
     TARGET_AGENT,
     TARGET_POINT,
     TARGET_ROBOT,

@@ -1,7 +1,15 @@
 """Pedestrian social states (Arena's crowdsim statechart).
 
-Split into parameters, perception and the statechart itself; :mod:`arena.crowd.social_states`
-re-exports the public names.
+Split into ``params`` (distributions and their sampling), ``perception`` (vision) and
+``statechart`` (:class:`SocialStates`). Use::
+
+    from arena.crowd.social import SocialStates, SocialStatesParams
+
+    social = SocialStates(SocialStatesParams())
+    social.reset(state, world, rng)               # once per episode
+    social.pre(state, robots, world, dt)          # before the crowd model
+    acc = social.post(state, acc, dt)             # on the model's accelerations
+    social.orient(state)                          # after integration
 """
 
 from arena.crowd.social.params import (
