@@ -179,7 +179,7 @@ def main() -> None:
     names = args.models or CROWD_MODELS.names()
     print(f"crowd step, ms per step (1 core; 40 x 40 m hall with walls; {args.steps} steps)")
     print("full = CrowdSimulator.step (neighbour search + model + integrator with wall guard);")
-    print("model = the model's compute() alone")
+    print("model = the model's compute(), including the neighbour search it triggers (lazy)")
     head = "".join(f"{f'full {n:,d}':>13}{f'model {n:,d}':>13}" for n in args.sizes)
     print(f"{'model':<20}{head}")
     for name in names:

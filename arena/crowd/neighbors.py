@@ -7,7 +7,6 @@ Every crowd model gets its pedestrian pairs from here, and models with many stat
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -19,13 +18,17 @@ IntArray = NDArray[np.int64]
 _MAX_CELLS = 4_000_000  # dense cell table cap; coarser cells beyond it
 
 
-@dataclass(frozen=True, eq=False)
 class Neighbors:
-    """Neighbour lists in CSR form.
+    """Neighbour lists in CSR form, and the unique pairs.
 
     The neighbours of query ``i`` are ``indices[indptr[i]:indptr[i + 1]]``, each strictly
     closer than ``cutoff``; a point is never its own neighbour in a self-query. The order is
     deterministic (cell by cell) but not sorted; models that need nearest-first sort.
+
+    Built from CSR arrays, or by :func:`find_neighbors` from a cell list, in which case both
+    forms are computed on first use: pair models (PySocialForce) read only
+    :meth:`unique_pairs`, which a half search finds with half the distance checks, and never
+    pay for the CSR; per-agent models (ORCA, pedsim) read ``indptr``/``indices``. Read-only.
 
     Attributes:
         indptr: ``(q + 1,)`` offsets.
@@ -33,11 +36,50 @@ class Neighbors:
         cutoff: the search radius (m); ``inf`` means all pairs.
     """
 
-    indptr: IntArray
-    indices: IntArray
-    cutoff: float
+    __slots__ = ("_cells", "_cutoff", "_indices", "_indptr", "_pairs")
+
+    def __init__(self, indptr: IntArray, indices: IntArray, cutoff: float) -> None:
+        self._indptr: IntArray | None = indptr
+        self._indices: IntArray | None = indices
+        self._pairs: tuple[IntArray, IntArray] | None = None
+        self._cells: CellList | None = None
+        self._cutoff = cutoff
+
+    @classmethod
+    def _deferred(cls, cells: CellList, cutoff: float) -> Neighbors:
+        """The self-query of ``cells.points`` within ``cutoff``, computed when first read."""
+        nb = cls.__new__(cls)
+        nb._indptr = nb._indices = None
+        nb._pairs = None
+        nb._cells = cells
+        nb._cutoff = cutoff
+        return nb
+
+    @property
+    def cutoff(self) -> float:
+        """The search radius (m); ``inf`` means all pairs."""
+        return self._cutoff
+
+    def _csr(self) -> tuple[IntArray, IntArray]:
+        if self._indptr is None or self._indices is None:
+            assert self._cells is not None
+            full = self._cells.query(self._cells.points, self.cutoff, exclude_self=True)
+            self._indptr, self._indices = full.indptr, full.indices
+        return self._indptr, self._indices
+
+    @property
+    def indptr(self) -> IntArray:
+        """``(q + 1,)`` offsets."""
+        return self._csr()[0]
+
+    @property
+    def indices(self) -> IntArray:
+        """``(m,)`` neighbour indices."""
+        return self._csr()[1]
 
     def __len__(self) -> int:
+        if self._indptr is None and self._cells is not None:
+            return int(self._cells.points.shape[0])
         return int(self.indptr.shape[0] - 1)
 
     def of(self, i: int) -> IntArray:
@@ -48,6 +90,32 @@ class Neighbors:
         """``(i, j)`` arrays of every listed pair (each unordered pair appears twice)."""
         counts = np.diff(self.indptr)
         return np.repeat(np.arange(len(self), dtype=np.int64), counts), self.indices
+
+    def unique_pairs(self) -> tuple[IntArray, IntArray]:
+        """``(i, j)`` ``(p,)`` arrays of each listed pair once, with ``i < j`` (self-queries).
+
+        Ordered as the CSR rows: by ``i``, then each ``j`` in its place in row ``i``; i.e. the
+        entries ``j > i`` of :meth:`pairs`. Computed once, then cached; do not modify.
+        """
+        if self._pairs is None:
+            c = self._cells
+            if self._indptr is None and c is not None:
+                self._pairs = _half_pairs(
+                    c.points,
+                    c.order,
+                    c.starts,
+                    c.origin[0],
+                    c.origin[1],
+                    c.cell,
+                    c.shape[0],
+                    c.shape[1],
+                    float(self.cutoff),
+                    max(1, math.ceil(self.cutoff / c.cell)),
+                )
+            else:
+                indptr, indices = self._csr()
+                self._pairs = _upper_pairs(indptr, indices)
+        return self._pairs
 
 
 class CellList:
@@ -124,7 +192,9 @@ def find_neighbors(positions: FloatArray, cutoff: float) -> Neighbors:
         indptr, indices = _all_pairs(n, n, True)
         return Neighbors(indptr, indices, math.inf)
     # Half-cutoff cells scan 25 quarter-size cells (6.25 cutoff²) instead of 9 full ones (9).
-    return CellList(positions, 0.5 * cutoff).query(positions, cutoff, exclude_self=True)
+    # A copy: the lists are computed when first read, and the caller may move its agents.
+    pts = np.array(positions, dtype=np.float64).reshape(-1, 2)
+    return Neighbors._deferred(CellList(pts, 0.5 * cutoff), float(cutoff))
 
 
 @njit(cache=True)
@@ -261,3 +331,89 @@ def _all_pairs(nq: int, n: int, exclude_self: bool) -> tuple[IntArray, IntArray]
             indices[k] = j
             k += 1
     return indptr, indices
+
+
+@njit(cache=True)
+def _half_pairs(
+    pts: FloatArray,
+    order: IntArray,
+    starts: IntArray,
+    ox: float,
+    oy: float,
+    cell: float,
+    nx: int,
+    ny: int,
+    radius: float,
+    rings: int,
+) -> tuple[IntArray, IntArray]:
+    """Pairs ``i < j`` of the points closer than ``radius``, in the order of ``_query``'s rows.
+
+    Each point scans the same cells as ``_query`` but measures only the points ``j > i``: half
+    the distance checks, in one pass. The distance test is ``_scan``'s, symmetric in ``i`` and
+    ``j`` to the bit, so the set is exactly the CSR's.
+
+    Returns:
+        ``(i, j)``, each ``(p,)``.
+    """
+    n = pts.shape[0]
+    r2 = radius * radius
+    cap = 32 * n + 64
+    pi = np.empty(cap, dtype=np.int64)
+    pj = np.empty(cap, dtype=np.int64)
+    m = 0
+    for i in range(n):
+        x = pts[i, 0]
+        y = pts[i, 1]
+        cx = int((x - ox) // cell)
+        cy = int((y - oy) // cell)
+        gx0 = max(cx - rings, 0)
+        gx1 = min(cx + rings, nx - 1) + 1
+        gy0 = max(cy - rings, 0)
+        gy1 = min(cy + rings, ny - 1) + 1
+        # Room for every candidate of the row first: the writes below are then unconditional.
+        bound = 0
+        for gy in range(gy0, gy1):
+            bound += starts[gy * nx + gx1] - starts[gy * nx + gx0]
+        if m + bound > cap:
+            cap = max(2 * cap, m + bound)
+            grown_i = np.empty(cap, dtype=np.int64)
+            grown_j = np.empty(cap, dtype=np.int64)
+            grown_i[:m] = pi[:m]
+            grown_j[:m] = pj[:m]
+            pi = grown_i
+            pj = grown_j
+        for gy in range(gy0, gy1):
+            # A row of cells is one run of ``order``: cells are numbered row by row.
+            for s in range(starts[gy * nx + gx0], starts[gy * nx + gx1]):
+                j = order[s]
+                # A cell lists its points in ascending index order (stable sort): the skipped
+                # j <= i are a prefix of each cell, a well-predicted branch.
+                if j <= i:
+                    continue
+                dx = pts[j, 0] - x
+                dy = pts[j, 1] - y
+                # Written always, kept if close: no mispredicted branch on the distance test.
+                pi[m] = i
+                pj[m] = j
+                m += dx * dx + dy * dy < r2
+    return pi[:m], pj[:m]
+
+
+@njit(cache=True)
+def _upper_pairs(indptr: IntArray, indices: IntArray) -> tuple[IntArray, IntArray]:
+    """The entries ``j > i`` of CSR rows ``i``, as ``(i, j)`` arrays in CSR order."""
+    m = 0
+    for i in range(indptr.shape[0] - 1):
+        for k in range(indptr[i], indptr[i + 1]):
+            if indices[k] > i:
+                m += 1
+    pi = np.empty(m, dtype=np.int64)
+    pj = np.empty(m, dtype=np.int64)
+    m = 0
+    for i in range(indptr.shape[0] - 1):
+        for k in range(indptr[i], indptr[i + 1]):
+            if indices[k] > i:
+                pi[m] = i
+                pj[m] = indices[k]
+                m += 1
+    return pi, pj

@@ -111,9 +111,13 @@ PySocialForce does.
 
 Implementation: the social term visits each unordered pair once for both agents (the reverse
 direction has ``e' = −e``, ``D' = −D``, so the same ``|D|``, ``B`` and wrapped angle; only the
-±2π correction differs). Pairs are processed in blocks: numba kernels for the geometry, the
-angles and the accumulation, NumPy's SIMD ``arctan2`` and ``exp`` in between, about 3× faster
-than calling libm from inside a numba loop. The obstacle term scans the point grid directly.
+±2π correction differs). The pairs come from :meth:`Neighbors.unique_pairs` (a half search,
+no CSR). They are processed in blocks: numba kernels for the geometry, the angles and the
+accumulation, NumPy's SIMD ``arctan2`` and ``exp`` in between, about 3× faster than calling libm
+from inside a numba loop; the geometry and angle kernels are branch-free in the common case so
+that LLVM vectorises them (IEEE sqrt and division give the scalar bits), with the rare cases
+(signed zeros, coincident agents, ``Δv = 0``) redone by the scalar formula. The obstacle term
+scans the point grid directly, skipping runs of points whose bounding box is out of reach.
 """
 
 from __future__ import annotations
@@ -149,6 +153,8 @@ TERMS = (
 _TWO_PI = 2.0 * math.pi
 _CHUNK = 8192
 """Pairs per block of the social pipeline: a block's work arrays (~1 MB) stay in cache."""
+_BLOCK = 8
+"""Obstacle points per bounding box (0.8 m of wall at PySocialForce's 10 points per metre)."""
 
 
 @CROWD_MODELS.register("pysocial", tags=("social_force", "default"))
@@ -254,8 +260,8 @@ class PySocialModel:
         self.params = params or self.Params()
         self.obstacle_points: FloatArray = np.zeros((0, 2))
         self._cells = CellList(self.obstacle_points, 1.0)
+        self._blocks = _point_blocks(self._cells.points, self._cells.order, self._cells.starts)
         self._work: dict[str, NDArray[np.generic]] | None = None
-        self._pairs = np.zeros((2, 0), dtype=np.int64)
 
     def neighbor_cutoff(self) -> float:
         """The social interaction range ``cutoff`` (m)."""
@@ -280,6 +286,7 @@ class PySocialModel:
         p = self.params
         r = p.agent_radius if p.agent_radius is not None else max_radius
         self._cells = CellList(self.obstacle_points, p.obstacle_threshold + 2.0 * r)
+        self._blocks = _point_blocks(self._cells.points, self._cells.order, self._cells.starts)
 
     def compute(self, frame: CrowdFrame) -> ModelOutput:
         """PySocialForce's forces for every active agent (zero for inactive ones)."""
@@ -299,8 +306,11 @@ class PySocialModel:
         )
         terms["desired"] *= p.desired_factor
 
-        nb = frame.neighbors
-        self._social_term(pos, vel, active, nb.indptr, nb.indices, terms["social"])
+        pi, pj = frame.neighbors.unique_pairs()
+        if not active.all():  # pairs of two inactive agents exert nothing on anyone
+            keep = active[pi] | active[pj]
+            pi, pj = pi[keep], pj[keep]
+        self._social_term(pos, vel, pi, pj, terms["social"])
         terms["social"] *= p.social_factor
 
         if len(frame.robots) and p.robot_factor > 0.0:
@@ -333,7 +343,7 @@ class PySocialModel:
                 active,
                 cells.points,
                 cells.order,
-                cells.starts,
+                *self._blocks,
                 float(cells.origin[0]),
                 float(cells.origin[1]),
                 float(cells.cell),
@@ -379,35 +389,36 @@ class PySocialModel:
         self,
         pos: FloatArray,
         vel: FloatArray,
-        active: NDArray[np.bool_],
-        indptr: IntArray,
-        indices: IntArray,
+        pi: IntArray,
+        pj: IntArray,
         out: FloatArray,
     ) -> None:
         """Add the pedestrian interaction (before its factor) to ``out`` ``(n, 2)``.
+
+        ``pi``, ``pj``: ``(m,)`` the unordered pairs ``i < j`` to evaluate.
 
         Each unordered pair is evaluated once for both agents, in blocks: numba kernels for the
         geometry, the angles and the accumulation, NumPy's SIMD ``arctan2`` and ``exp`` in
         between (several times faster than scalar libm calls from inside a numba loop).
         """
         p = self.params
-        # Work arrays live across steps: fresh large arrays would page-fault every step.
-        if self._pairs.shape[1] < indices.shape[0]:
-            self._pairs = np.empty((2, int(indices.shape[0] * 1.25) + 16), dtype=np.int64)
-        pi = self._pairs[0]
-        pj = self._pairs[1]
-        m = _pair_list(active, indptr, indices, pi, pj)
+        m = pi.shape[0]
         if m == 0:
             return
+        # Work arrays live across steps: fresh large arrays would page-fault every step.
         k = min(m, _CHUNK)
         if self._work is None or self._work["sn"].shape[0] < k:
+            # The geometry rows share one array: the vectorised kernel needs few base pointers.
+            geo = np.empty((6, k))
             self._work = {
-                "sn": np.empty(k),
-                "cs": np.empty(k),
-                "base": np.empty(k),
-                "bb": np.empty(k),
-                "tx": np.empty(k),
-                "ty": np.empty(k),
+                "gather": np.empty((4, k)),
+                "geo": geo,
+                "sn": geo[0],
+                "cs": geo[1],
+                "base": geo[2],
+                "bb": geo[3],
+                "tx": geo[4],
+                "ty": geo[5],
                 "code": np.empty(k, dtype=np.int64),
                 "w": np.empty(k),
                 "args": np.empty((4, k)),
@@ -428,22 +439,15 @@ class PySocialModel:
                 float(p.cutoff),
                 p.lambda_importance,
                 p.gamma,
-                wk["sn"],
-                wk["cs"],
-                wk["base"],
-                wk["bb"],
-                wk["tx"],
-                wk["ty"],
+                wk["gather"],
+                wk["geo"],
                 wk["code"],
             )
             np.arctan2(wk["sn"][:c], wk["cs"][:c], out=wk["w"][:c])
             _pair_exponents(
                 wk["w"],
                 wk["code"],
-                wk["base"],
-                wk["bb"],
-                wk["tx"],
-                wk["ty"],
+                wk["geo"],
                 c,
                 p.n,
                 p.n_prime,
@@ -535,23 +539,6 @@ def group_members(group: IntArray) -> tuple[IntArray, IntArray]:
     return order.astype(np.int64), starts
 
 
-@njit(cache=True)
-def _pair_list(
-    active: NDArray[np.bool_], indptr: IntArray, indices: IntArray, pi: IntArray, pj: IntArray
-) -> int:
-    """Unordered pairs ``i < j`` of the (symmetric) neighbour lists with an active member."""
-    m = 0
-    for i in range(indptr.shape[0] - 1):
-        ai = active[i]
-        for k in range(indptr[i], indptr[i + 1]):
-            j = indices[k]
-            if j > i and (ai or active[j]):
-                pi[m] = i
-                pj[m] = j
-                m += 1
-    return m
-
-
 @njit(cache=True, inline="always")
 def _upper(x: float, y: float) -> int:
     """1 if ``atan2(y, x) > 0``, else 0 (signed zeros included: ``atan2(+0, x < 0) = +π``)."""
@@ -571,12 +558,8 @@ def _pair_geometry(
     cutoff: float,
     lam: float,
     gamma: float,
-    sn: FloatArray,
-    cs: FloatArray,
-    base: FloatArray,
-    bb: FloatArray,
-    tx: FloatArray,
-    ty: FloatArray,
+    gather: FloatArray,
+    geo: FloatArray,
     code: IntArray,
 ) -> None:
     """Per pair ``lo..hi``: the atan2 arguments, ``−d/B``, ``B``, ``t`` and the half-plane bits.
@@ -587,60 +570,131 @@ def _pair_geometry(
     is ``w`` shifted by ∓2π where the rotation from ``e`` to ``t`` crosses the negative x-axis;
     the bits record which half-plane each of the four vectors lies in (from the reverse vectors
     formed as PySocialForce forms them, so signed zeros match) and ``d = 0``.
+
+    Args:
+        pos: ``(n, 2)`` positions (m).
+        vel: ``(n, 2)`` velocities (m/s).
+        pi: ``(p,)`` first agents of the pairs.
+        pj: ``(p,)`` second agents.
+        lo: first pair of the block.
+        hi: end of the block (exclusive).
+        cutoff: interaction range (m); pairs beyond it exert nothing.
+        lam: λ (s/m).
+        gamma: γ (m).
+        gather: ``(4, ≥ hi − lo)`` scratch.
+        geo: ``(6, ≥ hi − lo)`` out: rows ``sin w``/``cos w`` (atan2 arguments), ``−d/B``,
+            ``B``, ``t_x``, ``t_y``.
+        code: ``(≥ hi − lo,)`` out: the half-plane bits, 16 for ``d = 0``.
     """
     c2 = cutoff * cutoff
-    for p in range(lo, hi):
-        q = p - lo
-        i = pi[p]
-        j = pj[p]
-        px = pos[i, 0]
-        py = pos[i, 1]
-        ox = pos[j, 0]
-        oy = pos[j, 1]
-        dvx = vel[j, 0] - vel[i, 0]
-        dvy = vel[j, 1] - vel[i, 1]
-        dx = px - ox
-        dy = py - oy
+    c = hi - lo
+    for q in range(c):  # gather first: the main loop is then SIMD-vectorised (no indirection)
+        i = pi[lo + q]
+        j = pj[lo + q]
+        gather[0, q] = pos[i, 0] - pos[j, 0]
+        gather[1, q] = pos[i, 1] - pos[j, 1]
+        gather[2, q] = vel[j, 0] - vel[i, 0]
+        gather[3, q] = vel[j, 1] - vel[i, 1]
+    rare = 0
+    for q in range(c):
+        # The common case, branch-free so that LLVM vectorises it (IEEE sqrt and division are
+        # exact in SIMD too: the same bits as the scalar formula). With ``e_y ≠ 0``,
+        # ``t_y ≠ 0``, ``Δv ≠ 0`` and ``d < cutoff`` the reverse vectors are the exact
+        # negatives, so their bits are the opposite signs; the other pairs (flag 32) are
+        # redone below by the scalar formula, which handles the signed zeros.
+        dx = gather[0, q]
+        dy = gather[1, q]
+        dvx = gather[2, q]
+        dvy = gather[3, q]
         d2 = dx * dx + dy * dy
         d = math.sqrt(d2)
-        inv_d = 1.0 / d if d > 0.0 else 0.0  # e = 0 for coincident agents, as upstream
+        inv_d = 1.0 / d if d > 0.0 else 0.0  # a select: no division by zero, still SIMD
         ex = dx * inv_d
         ey = dy * inv_d
-        rex = (ox - px) * inv_d
-        rey = (oy - py) * inv_d
         ix = lam * dvx + ex
         iy = lam * dvy + ey
         length = math.sqrt(ix * ix + iy * iy)
         inv_l = 1.0 / length if length > 0.0 else 0.0
         t_x = ix * inv_l
         t_y = iy * inv_l
-        rtx = (lam * (vel[i, 0] - vel[j, 0]) + rex) * inv_l
-        rty = (lam * (vel[i, 1] - vel[j, 1]) + rey) * inv_l
-        if d == 0.0:
-            sn[q] = t_y  # e = 0: θ = atan2(t)
-            cs[q] = t_x
-        elif dvx == 0.0 and dvy == 0.0:
-            sn[q] = 0.0  # D = e: θ = 0 exactly, not ±1 ulp of rounding noise
-            cs[q] = 1.0
-        else:
-            sn[q] = ex * t_y - ey * t_x
-            cs[q] = ex * t_x + ey * t_y
-        # Outside the cutoff (a wider neighbour search) or D = 0: both directions exactly 0
-        # (upstream's 0·exp(−d/0); NaN if d = 0 too, which Arena zeroed).
-        base[q] = -d * inv_l / gamma if (length > 0.0 and d2 < c2) else -math.inf
-        bb[q] = gamma * length
-        tx[q] = t_x
-        ty[q] = t_y
-        if ey == 0.0 or t_y == 0.0 or rey == 0.0 or rty == 0.0:  # rare: signed zeros matter
-            code[q] = (
-                _upper(ex, ey)
-                + 2 * _upper(t_x, t_y)
-                + 4 * _upper(rex, rey)
-                + 8 * _upper(rtx, rty)
-                + (16 if d == 0.0 else 0)
-            )
-        else:
-            code[q] = (ey > 0.0) + 2 * (t_y > 0.0) + 4 * (rey > 0.0) + 8 * (rty > 0.0)
+        geo[0, q] = ex * t_y - ey * t_x
+        geo[1, q] = ex * t_x + ey * t_y
+        geo[2, q] = -d * inv_l / gamma
+        geo[3, q] = gamma * length
+        geo[4, q] = t_x
+        geo[5, q] = t_y
+        flag = (ey == 0.0) | (t_y == 0.0) | ((dvx == 0.0) & (dvy == 0.0)) | (d2 >= c2)
+        code[q] = (ey > 0.0) + 2 * (t_y > 0.0) + 4 * (ey < 0.0) + 8 * (t_y < 0.0) + 32 * flag
+        rare += flag
+    if rare == 0:
+        return
+    for q in range(c):
+        if code[q] >= 32:
+            _pair_geometry_one(pos, vel, pi[lo + q], pj[lo + q], q, c2, lam, gamma, geo, code)
+
+
+@njit(cache=True, inline="always")
+def _pair_geometry_one(
+    pos: FloatArray,
+    vel: FloatArray,
+    i: int,
+    j: int,
+    q: int,
+    c2: float,
+    lam: float,
+    gamma: float,
+    geo: FloatArray,
+    code: IntArray,
+) -> None:
+    """:func:`_pair_geometry` for the pair ``(i, j)`` into column ``q``, every case handled."""
+    px = pos[i, 0]
+    py = pos[i, 1]
+    ox = pos[j, 0]
+    oy = pos[j, 1]
+    dvx = vel[j, 0] - vel[i, 0]
+    dvy = vel[j, 1] - vel[i, 1]
+    dx = px - ox
+    dy = py - oy
+    d2 = dx * dx + dy * dy
+    d = math.sqrt(d2)
+    inv_d = 1.0 / d if d > 0.0 else 0.0  # e = 0 for coincident agents, as upstream
+    ex = dx * inv_d
+    ey = dy * inv_d
+    rex = (ox - px) * inv_d
+    rey = (oy - py) * inv_d
+    ix = lam * dvx + ex
+    iy = lam * dvy + ey
+    length = math.sqrt(ix * ix + iy * iy)
+    inv_l = 1.0 / length if length > 0.0 else 0.0
+    t_x = ix * inv_l
+    t_y = iy * inv_l
+    rtx = (lam * (vel[i, 0] - vel[j, 0]) + rex) * inv_l
+    rty = (lam * (vel[i, 1] - vel[j, 1]) + rey) * inv_l
+    if d == 0.0:
+        geo[0, q] = t_y  # e = 0: θ = atan2(t)
+        geo[1, q] = t_x
+    elif dvx == 0.0 and dvy == 0.0:
+        geo[0, q] = 0.0  # D = e: θ = 0 exactly, not ±1 ulp of rounding noise
+        geo[1, q] = 1.0
+    else:
+        geo[0, q] = ex * t_y - ey * t_x
+        geo[1, q] = ex * t_x + ey * t_y
+    # Outside the cutoff (a wider neighbour search) or D = 0: both directions exactly 0
+    # (upstream's 0·exp(−d/0); NaN if d = 0 too, which Arena zeroed).
+    geo[2, q] = -d * inv_l / gamma if (length > 0.0 and d2 < c2) else -math.inf
+    geo[3, q] = gamma * length
+    geo[4, q] = t_x
+    geo[5, q] = t_y
+    if ey == 0.0 or t_y == 0.0 or rey == 0.0 or rty == 0.0:  # rare: signed zeros matter
+        code[q] = (
+            _upper(ex, ey)
+            + 2 * _upper(t_x, t_y)
+            + 4 * _upper(rex, rey)
+            + 8 * _upper(rtx, rty)
+            + (16 if d == 0.0 else 0)
+        )
+    else:
+        code[q] = (ey > 0.0) + 2 * (t_y > 0.0) + 4 * (rey > 0.0) + 8 * (rty > 0.0)
 
 
 @njit(cache=True, inline="always")
@@ -657,10 +711,7 @@ def _unwrap(w: float, upper_e: bool, upper_t: bool) -> float:
 def _pair_exponents(
     w: FloatArray,
     code: IntArray,
-    base: FloatArray,
-    bb: FloatArray,
-    tx: FloatArray,
-    ty: FloatArray,
+    geo: FloatArray,
     m: int,
     n: float,
     n_prime: float,
@@ -668,29 +719,62 @@ def _pair_exponents(
     args: FloatArray,
     sg: FloatArray,
 ) -> None:
-    """θ for both agents of each pair, the four exponents and the signs of θ."""
+    """θ for both agents of each pair, the four exponents and the signs of θ.
+
+    Args:
+        w: ``(≥ m,)`` wrapped angles from ``e`` to ``t`` (rad).
+        code: ``(≥ m,)`` half-plane bits of :func:`_pair_geometry`.
+        geo: ``(6, ≥ m)`` :func:`_pair_geometry`'s rows (``−d/B``, ``B``, ``t`` used here).
+        m: pairs in the block.
+        n: angular decay n (1/m).
+        n_prime: angular decay n' (1/m).
+        wrap: θ wrapped into (−π, π] instead of PySocialForce's raw difference.
+        args: ``(4, ≥ m)`` out: exponents (braking, turning) for ``i``, then for ``j``.
+        sg: ``(2, ≥ m)`` out: ``sign θ`` for ``i`` and ``j``.
+    """
+    coincident = 0
     for q in range(m):
+        # Branch-free (selects) so that it vectorises; _unwrap written out. Coincident pairs
+        # (bit 16) are redone below.
         cd = code[q]
         wq = w[q]
-        if cd & 16:  # d = 0: each agent's θ is the angle of its own t (upstream e = 0)
-            th_i = wq
-            rtx = -tx[q] if tx[q] != 0.0 else 0.0
-            rty = -ty[q] if ty[q] != 0.0 else 0.0
-            th_j = math.atan2(rty, rtx)
-        elif wrap:
-            th_i = wq
-            th_j = wq
-        else:
-            th_i = _unwrap(wq, (cd & 1) != 0, (cd & 2) != 0)
-            th_j = _unwrap(wq, (cd & 4) != 0, (cd & 8) != 0)
-        b = bb[q]
-        bs = base[q]
+        ue = (cd & 1) != 0
+        ut = (cd & 2) != 0
+        re = (cd & 4) != 0
+        rt = (cd & 8) != 0
+        down_i = ue & (~ut) & (wq > 0.0)
+        up_i = ut & (~ue) & (wq < 0.0)
+        down_j = re & (~rt) & (wq > 0.0)
+        up_j = rt & (~re) & (wq < 0.0)
+        th_i = wq - _TWO_PI if down_i else (wq + _TWO_PI if up_i else wq)
+        th_j = wq - _TWO_PI if down_j else (wq + _TWO_PI if up_j else wq)
+        th_i = wq if wrap else th_i
+        th_j = wq if wrap else th_j
+        b = geo[3, q]
+        bs = geo[2, q]
         args[0, q] = bs - (n_prime * b * th_i) ** 2
         args[1, q] = bs - (n * b * th_i) ** 2
         args[2, q] = bs - (n_prime * b * th_j) ** 2
         args[3, q] = bs - (n * b * th_j) ** 2
         sg[0, q] = (th_i > 0.0) - (th_i < 0.0)
         sg[1, q] = (th_j > 0.0) - (th_j < 0.0)
+        coincident += (cd & 16) != 0
+    if coincident == 0:
+        return
+    for q in range(m):
+        if code[q] & 16:  # d = 0: each agent's θ is the angle of its own t (upstream e = 0)
+            th_i = w[q]
+            rtx = -geo[4, q] if geo[4, q] != 0.0 else 0.0
+            rty = -geo[5, q] if geo[5, q] != 0.0 else 0.0
+            th_j = math.atan2(rty, rtx)
+            b = geo[3, q]
+            bs = geo[2, q]
+            args[0, q] = bs - (n_prime * b * th_i) ** 2
+            args[1, q] = bs - (n * b * th_i) ** 2
+            args[2, q] = bs - (n_prime * b * th_j) ** 2
+            args[3, q] = bs - (n * b * th_j) ** 2
+            sg[0, q] = (th_i > 0.0) - (th_i < 0.0)
+            sg[1, q] = (th_j > 0.0) - (th_j < 0.0)
 
 
 @njit(cache=True)
@@ -779,7 +863,9 @@ def _obstacle(
     active: NDArray[np.bool_],
     pts: FloatArray,
     order: IntArray,
-    starts: IntArray,
+    cell_blocks: IntArray,
+    block_lo: IntArray,
+    bbox: FloatArray,
     gx0: float,
     gy0: float,
     cell: float,
@@ -792,8 +878,11 @@ def _obstacle(
 ) -> None:
     """PySocialForce's ``ObstacleForce`` (before its factor), scanning the point grid directly.
 
-    ``order``/``starts`` and the grid geometry are a :class:`CellList`'s; ``reach`` bounds the
-    search, the exact PySocialForce test ``|r − o| − R < threshold + R`` selects the points.
+    ``order`` and the grid geometry are a :class:`CellList`'s, its cells cut into blocks by
+    :func:`_point_blocks`; ``reach`` bounds the search, the exact PySocialForce test
+    ``|r − o| − R < threshold + R`` selects the points. A block whose bounding box is beyond
+    the prefilter is skipped whole: its points would all fail it (rounded differences and
+    squares are monotone), so the sums, in the same order, are the same to the bit.
     """
     rings = max(1, math.ceil(reach / cell))
     for i in range(pos.shape[0]):
@@ -811,21 +900,67 @@ def _obstacle(
         for gy in range(max(cy - rings, 0), min(cy + rings, ny - 1) + 1):
             for gx in range(max(cx - rings, 0), min(cx + rings, nx - 1) + 1):
                 c = gy * nx + gx
-                for s in range(starts[c], starts[c + 1]):
-                    j = order[s]
-                    dx = x - pts[j, 0]
-                    dy = y - pts[j, 1]
-                    d2 = dx * dx + dy * dy
-                    if d2 >= far2:
+                for blk in range(cell_blocks[c], cell_blocks[c + 1]):
+                    bx = max(bbox[blk, 0] - x, x - bbox[blk, 1], 0.0)
+                    by = max(bbox[blk, 2] - y, y - bbox[blk, 3], 0.0)
+                    if bx * bx + by * by >= far2:
                         continue
-                    dist = math.sqrt(d2)
-                    gap = dist - r
-                    if gap < thr and dist > 0.0:
-                        w = math.exp(-gap / sigma)
-                        fx += dx / dist * w
-                        fy += dy / dist * w
+                    for s in range(block_lo[blk], block_lo[blk + 1]):
+                        j = order[s]
+                        dx = x - pts[j, 0]
+                        dy = y - pts[j, 1]
+                        d2 = dx * dx + dy * dy
+                        if d2 >= far2:
+                            continue
+                        dist = math.sqrt(d2)
+                        gap = dist - r
+                        if gap < thr and dist > 0.0:
+                            w = math.exp(-gap / sigma)
+                            fx += dx / dist * w
+                            fy += dy / dist * w
         out[i, 0] += fx
         out[i, 1] += fy
+
+
+@njit(cache=True)
+def _point_blocks(
+    points: FloatArray, order: IntArray, starts: IntArray
+) -> tuple[IntArray, IntArray, FloatArray]:
+    """Cut each cell's points into runs of ``_BLOCK`` (in cell order) with bounding boxes.
+
+    Wall samples are ordered along their segments, so a run is a short piece of wall with a
+    tight box, and most of a cell's runs lie beyond an agent's reach.
+
+    Returns:
+        ``(cell_blocks, block_lo, bbox)``: the blocks of cell ``c`` are
+        ``cell_blocks[c]:cell_blocks[c + 1]``, block ``b`` holds
+        ``order[block_lo[b]:block_lo[b + 1]]``, ``bbox[b]`` is ``(x_min, x_max, y_min, y_max)``
+        (m).
+    """
+    cells = starts.shape[0] - 1
+    cell_blocks = np.zeros(cells + 1, dtype=np.int64)
+    for c in range(cells):
+        cell_blocks[c + 1] = cell_blocks[c] + (starts[c + 1] - starts[c] + _BLOCK - 1) // _BLOCK
+    nb = cell_blocks[cells]
+    block_lo = np.empty(nb + 1, dtype=np.int64)
+    bbox = np.empty((nb, 4))
+    block_lo[nb] = starts[cells]
+    for c in range(cells):
+        for k in range(cell_blocks[c + 1] - cell_blocks[c]):
+            blk = cell_blocks[c] + k
+            lo = starts[c] + k * _BLOCK
+            hi = min(lo + _BLOCK, starts[c + 1])
+            block_lo[blk] = lo
+            bbox[blk, 0] = bbox[blk, 2] = math.inf
+            bbox[blk, 1] = bbox[blk, 3] = -math.inf
+            for s in range(lo, hi):
+                px = points[order[s], 0]
+                py = points[order[s], 1]
+                bbox[blk, 0] = min(bbox[blk, 0], px)
+                bbox[blk, 1] = max(bbox[blk, 1], px)
+                bbox[blk, 2] = min(bbox[blk, 2], py)
+                bbox[blk, 3] = max(bbox[blk, 3], py)
+    return cell_blocks, block_lo, bbox
 
 
 @njit(cache=True)
