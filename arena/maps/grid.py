@@ -76,7 +76,12 @@ class OccupancyGrid:
 
     @classmethod
     def empty(
-        cls, width_m: float, height_m: float, resolution: float = 0.05, *, walls: bool = True,
+        cls,
+        width_m: float,
+        height_m: float,
+        resolution: float = 0.05,
+        *,
+        walls: bool = True,
         origin: tuple[float, float] = (0.0, 0.0),
     ) -> OccupancyGrid:
         """Build a free ``width_m × height_m`` (m) map, with a one-cell wall border if asked."""

@@ -143,9 +143,7 @@ class MapMetadata(BaseModel):
 
 
 # -- loading ------------------------------------------------------------------------------------
-def load_map(
-    path: str | os.PathLike[str], *, unknown_is_occupied: bool = False
-) -> OccupancyGrid:
+def load_map(path: str | os.PathLike[str], *, unknown_is_occupied: bool = False) -> OccupancyGrid:
     """Load a ROS ``map.yaml`` and its image as an :class:`OccupancyGrid`.
 
     Args:
@@ -220,7 +218,8 @@ def _parse_metadata(doc: dict[Any, Any], source: str) -> MapMetadata:
             hint = f"did you mean {close[0]!r}? " if close else ""
             raise ConfigError(
                 f"unknown key; {hint}map.yaml keys are: {', '.join(known)}",
-                source=source, path=str(key),
+                source=source,
+                path=str(key),
             )
     try:
         return MapMetadata.model_validate(doc)
@@ -248,8 +247,9 @@ def _metadata_error(err: ValidationError, source: str) -> ConfigError:
 def _read_image(image_path: Path, source: str) -> tuple[NDArray[np.uint8], bool]:
     """Decode the image to ``(H, W, C)`` uint8 channels; ``True`` if the last one is alpha."""
     if not image_path.is_file():
-        raise ConfigError(f"image file not found (looked for {image_path})", source=source,
-                          path="image")
+        raise ConfigError(
+            f"image file not found (looked for {image_path})", source=source, path="image"
+        )
     try:
         with Image.open(image_path) as im:
             im.load()

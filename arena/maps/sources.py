@@ -138,3 +138,25 @@ class EmptyMap:
         """Build the room."""
         p = self.params
         return MapResult("empty", OccupancyGrid.empty(p.width, p.height, p.resolution))
+
+
+def write_world(result: MapResult, folder: str | Path) -> dict[str, Path]:
+    """Save a map as an Arena-style world folder.
+
+    Writes ``<folder>/map/map.yaml`` + ``map.png`` (ROS map_server) and
+    ``<folder>/map/obstacles.json``: the placed obstacles in Arena's scenario format
+    (``{"obstacles": {"static": [{"name", "model", "pos": [x, y, yaw]}]}}``).
+    """
+    import json
+
+    from arena.maps.io import save_map
+
+    folder = Path(folder)
+    yaml_path = save_map(result.grid, folder / "map" / "map.yaml", image_format="png")
+    static = [
+        {"name": o.name, "model": o.model, "pos": [round(float(v), 6) for v in o.pose]}
+        for o in result.obstacles
+    ]
+    obstacles = folder / "map" / "obstacles.json"
+    obstacles.write_text(json.dumps({"obstacles": {"static": static}}, indent=2))
+    return {"map": yaml_path, "obstacles": obstacles}

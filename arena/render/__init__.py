@@ -9,7 +9,15 @@ Example:
     ...         video.append(renderer.render(state, Overlay(text="running")))
 """
 
-from arena.render.frames import FrameRenderer, Overlay
+from arena.render.frames import FrameRenderer, Overlay, render_world
 from arena.render.video import RenderError, VideoWriter, render_episode, save_png
 
-__all__ = ["FrameRenderer", "Overlay", "RenderError", "VideoWriter", "render_episode", "save_png"]
+__all__ = [
+    "FrameRenderer",
+    "Overlay",
+    "RenderError",
+    "VideoWriter",
+    "render_episode",
+    "render_world",
+    "save_png",
+]

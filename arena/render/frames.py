@@ -34,7 +34,7 @@ from arena.core.geometry import regular_polygon, transform_points
 from arena.maps.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from arena.render import style
 from arena.sensors.spec import LidarSpec
-from arena.sim.state import AgentStates, RobotStates, SimState, StaticWorld
+from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 
 FloatArray = NDArray[np.float64]
 
@@ -251,8 +251,15 @@ class FrameRenderer:
         fontsize = self._font_size()
         if self.title:
             ax.text(
-                0.5, 1.0 - 8.0 / self.height_px, self.title, transform=ax.transAxes,
-                ha="center", va="top", fontsize=fontsize * 1.15, color=style.TEXT, zorder=20,
+                0.5,
+                1.0 - 8.0 / self.height_px,
+                self.title,
+                transform=ax.transAxes,
+                ha="center",
+                va="top",
+                fontsize=fontsize * 1.15,
+                color=style.TEXT,
+                zorder=20,
                 bbox=self._text_box(),
             )
 
@@ -267,20 +274,39 @@ class FrameRenderer:
             code = len(names) - 1 - k
             y = (8.0 + line * (k + 0.5)) / self.height_px
             ax.text(
-                x, y, f"{name} \u25cf", transform=ax.transAxes, ha="right", va="center",
-                fontsize=fs, color=style.TEXT, zorder=20,
+                x,
+                y,
+                f"{name} \u25cf",
+                transform=ax.transAxes,
+                ha="right",
+                va="center",
+                fontsize=fs,
+                color=style.TEXT,
+                zorder=20,
             )
             ax.text(
-                x, y, "\u25cf", transform=ax.transAxes, ha="right", va="center", fontsize=fs,
-                color=style.AGENT_STATE_COLORS[code], zorder=21,
+                x,
+                y,
+                "\u25cf",
+                transform=ax.transAxes,
+                ha="right",
+                va="center",
+                fontsize=fs,
+                color=style.AGENT_STATE_COLORS[code],
+                zorder=21,
             )
         top = (8.0 + line * len(names)) / self.height_px
         left = 1.0 - (8.0 + fs * 7.5 / 72.0 * _DPI) / self.width_px
         ax.add_patch(
             Rectangle(
-                (left, 4.0 / self.height_px), 1.0 - left - 4.0 / self.width_px,
-                top - 2.0 / self.height_px, transform=ax.transAxes, facecolor=style.TEXT_BOX,
-                alpha=style.TEXT_BOX_ALPHA, edgecolor="none", zorder=19,
+                (left, 4.0 / self.height_px),
+                1.0 - left - 4.0 / self.width_px,
+                top - 2.0 / self.height_px,
+                transform=ax.transAxes,
+                facecolor=style.TEXT_BOX,
+                alpha=style.TEXT_BOX_ALPHA,
+                edgecolor="none",
+                zorder=19,
             )
         )
 
@@ -308,22 +334,49 @@ class FrameRenderer:
         x0, y0 = left + pad, bottom + pad
         ax.add_patch(
             Rectangle(
-                (x0 - 0.5 * pad, y0 - 0.5 * pad), length + pad, bar_h + text_h + pad,
-                facecolor=style.TEXT_BOX, alpha=style.TEXT_BOX_ALPHA, edgecolor="none", zorder=20,
+                (x0 - 0.5 * pad, y0 - 0.5 * pad),
+                length + pad,
+                bar_h + text_h + pad,
+                facecolor=style.TEXT_BOX,
+                alpha=style.TEXT_BOX_ALPHA,
+                edgecolor="none",
+                zorder=20,
             )
         )
         # Half black, half white: the bar reads on both light and dark backgrounds.
         ax.add_patch(
-            Rectangle((x0, y0), length, bar_h, facecolor=style.TEXT, edgecolor=style.TEXT,
-                      linewidth=self._px(1.0), zorder=21)
+            Rectangle(
+                (x0, y0),
+                length,
+                bar_h,
+                facecolor=style.TEXT,
+                edgecolor=style.TEXT,
+                linewidth=self._px(1.0),
+                zorder=21,
+            )
         )
         ax.add_patch(
-            Rectangle((x0 + 0.5 * length, y0), 0.5 * length, bar_h, facecolor="white",
-                      edgecolor=style.TEXT, linewidth=self._px(1.0), zorder=22)
+            Rectangle(
+                (x0 + 0.5 * length, y0),
+                0.5 * length,
+                bar_h,
+                facecolor="white",
+                edgecolor=style.TEXT,
+                linewidth=self._px(1.0),
+                zorder=22,
+            )
         )
         label = f"{length:g} m"
-        ax.text(x0 + 0.5 * length, y0 + bar_h + 2.0 / s, label, ha="center", va="bottom",
-                fontsize=fontsize, color=style.TEXT, zorder=22)
+        ax.text(
+            x0 + 0.5 * length,
+            y0 + bar_h + 2.0 / s,
+            label,
+            ha="center",
+            va="bottom",
+            fontsize=fontsize,
+            color=style.TEXT,
+            zorder=22,
+        )
 
     # -- dynamic artists ------------------------------------------------------------------------
     def _make_dynamic(self) -> None:
@@ -331,42 +384,90 @@ class FrameRenderer:
         empty = np.zeros((0, 2))
 
         self._fans = PolyCollection([], edgecolors="none", linewidths=0.0, zorder=3)
-        self._trails = LineCollection([], linewidths=px(style.TRAIL_PX), zorder=4,
-                                      capstyle="round", joinstyle="round")
-        self._paths = LineCollection([], linewidths=px(style.PATH_PX), zorder=5,
-                                     capstyle="round", joinstyle="round")
+        self._trails = LineCollection(
+            [], linewidths=px(style.TRAIL_PX), zorder=4, capstyle="round", joinstyle="round"
+        )
+        self._paths = LineCollection(
+            [], linewidths=px(style.PATH_PX), zorder=5, capstyle="round", joinstyle="round"
+        )
         self._goal_arrows = PolyCollection([], linewidths=px(0.8), zorder=6)
         self._goal_marks = ax.scatter(
-            empty[:, 0], empty[:, 1], s=px(style.GOAL_MARKER_PX) ** 2, marker="o",
-            facecolors="none", linewidths=px(2.6), zorder=6,
+            empty[:, 0],
+            empty[:, 1],
+            s=px(style.GOAL_MARKER_PX) ** 2,
+            marker="o",
+            facecolors="none",
+            linewidths=px(2.6),
+            zorder=6,
         )
         self._subgoals = ax.scatter(
-            empty[:, 0], empty[:, 1], s=px(style.SUBGOAL_MARKER_PX) ** 2, marker="D",
-            linewidths=px(1.0), edgecolors=[style.HEADING], zorder=6,
+            empty[:, 0],
+            empty[:, 1],
+            s=px(style.SUBGOAL_MARKER_PX) ** 2,
+            marker="D",
+            linewidths=px(1.0),
+            edgecolors=[style.HEADING],
+            zorder=6,
         )
         self._agents = PolyCollection([], linewidths=px(style.AGENT_EDGE_PX), zorder=7)
-        self._agent_ticks = LineCollection([], linewidths=px(style.AGENT_EDGE_PX), zorder=7.1,
-                                           capstyle="round")
+        self._agent_ticks = LineCollection(
+            [], linewidths=px(style.AGENT_EDGE_PX), zorder=7.1, capstyle="round"
+        )
         self._hits = ax.scatter(
-            empty[:, 0], empty[:, 1], s=px(style.LIDAR_HIT_PX) ** 2, marker="o",
-            linewidths=0.0, zorder=7.5,
+            empty[:, 0],
+            empty[:, 1],
+            s=px(style.LIDAR_HIT_PX) ** 2,
+            marker="o",
+            linewidths=0.0,
+            zorder=7.5,
         )
         self._robots = PolyCollection([], zorder=8)
-        self._robot_heading = LineCollection([], colors=[style.HEADING],
-                                             linewidths=px(style.HEADING_PX), zorder=8.1,
-                                             capstyle="round")
-        self._hud = ax.text(
-            8.0 / self.width_px, 1.0 - 8.0 / self.height_px, "", transform=ax.transAxes,
-            ha="left", va="top", fontsize=self._font_size(), family="monospace",
-            color=style.TEXT, zorder=20, bbox=self._text_box(),
+        self._robot_heading = LineCollection(
+            [],
+            colors=[style.HEADING],
+            linewidths=px(style.HEADING_PX),
+            zorder=8.1,
+            capstyle="round",
         )
-        for coll in (self._fans, self._trails, self._paths, self._goal_arrows, self._agents,
-                     self._agent_ticks, self._robots, self._robot_heading):
+        self._hud = ax.text(
+            8.0 / self.width_px,
+            1.0 - 8.0 / self.height_px,
+            "",
+            transform=ax.transAxes,
+            ha="left",
+            va="top",
+            fontsize=self._font_size(),
+            family="monospace",
+            color=style.TEXT,
+            zorder=20,
+            bbox=self._text_box(),
+        )
+        for coll in (
+            self._fans,
+            self._trails,
+            self._paths,
+            self._goal_arrows,
+            self._agents,
+            self._agent_ticks,
+            self._robots,
+            self._robot_heading,
+        ):
             ax.add_collection(coll, autolim=False)
         self._dynamic = sorted(
-            (self._fans, self._trails, self._paths, self._goal_arrows, self._goal_marks,
-             self._subgoals, self._agents, self._agent_ticks, self._hits, self._robots,
-             self._robot_heading, self._hud),
+            (
+                self._fans,
+                self._trails,
+                self._paths,
+                self._goal_arrows,
+                self._goal_marks,
+                self._subgoals,
+                self._agents,
+                self._agent_ticks,
+                self._hits,
+                self._robots,
+                self._robot_heading,
+                self._hud,
+            ),
             key=lambda a: a.get_zorder(),
         )
         for artist in self._dynamic:
@@ -377,10 +478,21 @@ class FrameRenderer:
         # physical object, so it keeps its size on screen whatever the map size.
         length, head_len, head_w, shaft_w = 24.0, 9.0, 9.0, 2.4
         neck = length - head_len
-        self._arrow = np.array(
-            [[0.0, -shaft_w / 2], [neck, -shaft_w / 2], [neck, -head_w / 2], [length, 0.0],
-             [neck, head_w / 2], [neck, shaft_w / 2], [0.0, shaft_w / 2]], dtype=np.float64,
-        ) / self.scale
+        self._arrow = (
+            np.array(
+                [
+                    [0.0, -shaft_w / 2],
+                    [neck, -shaft_w / 2],
+                    [neck, -head_w / 2],
+                    [length, 0.0],
+                    [neck, head_w / 2],
+                    [neck, shaft_w / 2],
+                    [0.0, shaft_w / 2],
+                ],
+                dtype=np.float64,
+            )
+            / self.scale
+        )
 
     def _update_trails(self, state: SimState) -> None:
         if not self.show_trails:
@@ -598,10 +710,22 @@ def _map_image(
         cell = grid.resolution
     lut = np.zeros((4, 4), dtype=np.uint8)
     lut[1, :3], lut[2, :3], lut[3, :3] = (
-        style.to_uint8(style.FREE), style.to_uint8(style.UNKNOWN), style.to_uint8(style.OCCUPIED)
+        style.to_uint8(style.FREE),
+        style.to_uint8(style.UNKNOWN),
+        style.to_uint8(style.OCCUPIED),
     )
     lut[1:, 3] = 255
     image = lut[prio]
     ox, oy = grid.origin
     extent = (ox, ox + prio.shape[1] * cell, oy, oy + prio.shape[0] * cell)
     return image, extent
+
+
+def render_world(world: StaticWorld, *, width_px: int = 800, title: str = "") -> NDArray[np.uint8]:
+    """A top-down picture of a world with no robots or people (map previews, galleries)."""
+    robots = RobotStates(
+        (), (), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), (), ()
+    )
+    empty = SimState(0.0, 0, robots, AgentStates.empty(), Collisions.none(0))
+    renderer = FrameRenderer(world, width_px=width_px, title=title, show_trails=False)
+    return renderer.render(empty, Overlay(text=" "))

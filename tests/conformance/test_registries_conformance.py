@@ -1,11 +1,14 @@
 """One conformance test per plugin registry: every registered plugin is run."""
 
+import numpy as np
 import pytest
 
 import arena.plugins  # noqa: F401
+from arena.core.geometry import polygons_overlap
 from arena.core.registry import all_registries
 from arena.crowd.base import CROWD_MODELS
 from arena.crowd.simulator import CrowdSimulator
+from arena.maps.generators import MAP_GENERATORS
 from arena.maps.grid import OccupancyGrid
 from arena.maps.sources import MAP_SOURCES, MapResult
 from arena.sim.backend import BACKENDS
@@ -22,6 +25,7 @@ COVERED = {
     "global planner": "tests/conformance/test_planners_conformance.py",
     "local planner": "tests/conformance/test_planners_conformance.py",
     "robot": "tests/robots/test_presets.py",
+    "map generator": "here",
 }
 
 
@@ -57,8 +61,24 @@ def test_map_source(name, tmp_path):
         path = save_map(OccupancyGrid.empty(6, 5, 0.1), tmp_path / "m" / "map.yaml")
         params = {"path": str(path)}
     else:
-        params = MAP_PARAMS[name]
+        params = MAP_PARAMS.get(name, {})  # generators run on their defaults
     check_map_source(MAP_SOURCES.build({"type": name, **params}))
+
+
+@pytest.mark.parametrize("name", MAP_GENERATORS.names())
+def test_map_generator(name):
+    gen = MAP_GENERATORS.build(name)
+    check_map_source(gen)
+    for seed in range(3):
+        result = gen.build(np.random.default_rng(seed))
+        xmin, ymin, xmax, ymax = result.grid.bounds
+        polys = [o.polygon for o in result.obstacles]
+        for poly in polys:
+            assert poly[:, 0].min() >= xmin and poly[:, 0].max() <= xmax
+            assert poly[:, 1].min() >= ymin and poly[:, 1].max() <= ymax
+        for i, a in enumerate(polys):
+            for b in polys[i + 1 :]:
+                assert not polygons_overlap(a, b), f"{name}: overlapping obstacles (seed {seed})"
 
 
 @pytest.mark.parametrize("name", TASKS.names())
