@@ -23,8 +23,17 @@ def run_cli(monkeypatch, capsys, *args):
 def test_run_writes_trajectory_summary_and_video(monkeypatch, capsys, tmp_path):
     out = tmp_path / "run"
     code, stdout, _ = run_cli(
-        monkeypatch, capsys, "run", "task.agents=4", "task.time_limit=8", "--out", str(out),
-        "--robot", "burger", "output.width_px=320", "output.video_format=gif",
+        monkeypatch,
+        capsys,
+        "run",
+        "task.agents=4",
+        "task.time_limit=8",
+        "--out",
+        str(out),
+        "--robot",
+        "burger",
+        "output.width_px=320",
+        "output.video_format=gif",
     )
     assert code == 0, stdout
     ep = out / "episode_000"
@@ -86,3 +95,66 @@ def test_malformed_config_yaml(monkeypatch, capsys, tmp_path):
     code, _, err = run_cli(monkeypatch, capsys, "run", str(p))
     assert code == 2
     assert "malformed YAML at line" in " ".join(err.split())
+
+
+def test_maps_list_and_generate(monkeypatch, capsys, tmp_path):
+    code, out, _ = run_cli(monkeypatch, capsys, "maps", "list")
+    assert code == 0
+    for name in (
+        "barn",
+        "rosnav_indoor",
+        "rosnav_outdoor",
+        "outdoor",
+        "canteen",
+        "warehouse",
+        "office",
+        "small_office",
+    ):
+        assert name in out
+    world = tmp_path / "w"
+    code, out, err = run_cli(
+        monkeypatch,
+        capsys,
+        "maps",
+        "generate",
+        "canteen",
+        "chair_chance=1",
+        "--seed",
+        "3",
+        "-o",
+        str(world),
+        "--width-px",
+        "300",
+    )
+    assert code == 0, err
+    assert (world / "map" / "map.yaml").is_file()
+    assert (world / "preview.png").is_file()
+    data = json.loads((world / "map" / "obstacles.json").read_text())
+    models = [o["model"] for o in data["obstacles"]["static"]]
+    assert models.count("chair") == 4 * models.count("table") > 0
+    # The generated world loads as a map.
+    code, out, _ = run_cli(
+        monkeypatch,
+        capsys,
+        "run",
+        "--map",
+        str(world),
+        "--no-video",
+        "task.agents=2",
+        "task.time_limit=3",
+        "task.min_goal_distance=3",
+        "--out",
+        str(tmp_path / "run"),
+    )
+    assert code == 0, out
+
+
+def test_maps_generate_bad_parameter(monkeypatch, capsys, tmp_path):
+    code, _, err = run_cli(
+        monkeypatch, capsys, "maps", "generate", "barn", "fill_pc=0.2", "-o", str(tmp_path)
+    )
+    assert code == 2
+    assert "fill_pc: unknown key" in " ".join(err.split())
+    code, _, err = run_cli(monkeypatch, capsys, "maps", "generate", "warehous", "-o", str(tmp_path))
+    assert code == 2
+    assert "did you mean 'warehouse'" in " ".join(err.split())

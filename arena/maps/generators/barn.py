@@ -60,12 +60,8 @@ class GeneratorGridParams(BaseModel):
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
-    width: float = Field(
-        30.0, gt=0, description="m, map width (Arena 2024: 60 cells × 0.5 m)"
-    )
-    height: float = Field(
-        30.0, gt=0, description="m, map height (Arena 2024: 60 cells × 0.5 m)"
-    )
+    width: float = Field(30.0, gt=0, description="m, map width (Arena 2024: 60 cells × 0.5 m)")
+    height: float = Field(30.0, gt=0, description="m, map height (Arena 2024: 60 cells × 0.5 m)")
     cell_size: float = Field(
         0.5, gt=0,
         description="m, the generator's own cell (Arena's map_properties.resolution, 2024: 0.5)",
@@ -142,9 +138,7 @@ def barn_automaton(
         # corners count as filled (beyond the top/bottom border everything is wall).
         padded = np.pad(grid, ((0, 0), (1, 1)), constant_values=False)
         padded = np.pad(padded, ((1, 1), (0, 0)), constant_values=True)
-        count = ndimage.convolve(padded.astype(np.int16), _NEIGHBOURS, mode="constant")[
-            1:-1, 1:-1
-        ]
+        count = ndimage.convolve(padded.astype(np.int16), _NEIGHBOURS, mode="constant")[1:-1, 1:-1]
         # Synchronous update: counts come from the previous state only.
         grid = (count >= 5) | (grid & (count > 1))
     return grid
