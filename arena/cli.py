@@ -204,6 +204,26 @@ def maps_generate(
         console.print(f"{label + ':':10} {path}")
 
 
+scenario_app = typer.Typer(help="Arena scenario files.", no_args_is_help=True)
+app.add_typer(scenario_app, name="scenario")
+
+
+@scenario_app.command("validate")
+def scenario_validate(
+    path: Annotated[Path, typer.Argument(help="scenario JSON file")],
+    map_yaml: Annotated[
+        str | None, typer.Option("--map", help="map.yaml to check positions against")
+    ] = None,
+) -> None:
+    """Check a scenario file (and, with --map, that its positions lie on the map, not in walls)."""
+    from arena.tasks.scenario import validate_file
+
+    findings = validate_file(path, map_yaml)
+    for line in findings:
+        console.print(f"[yellow]warning:[/] {line}", highlight=False)
+    console.print(f"{path}: valid" + (f" ({len(findings)} warning(s))" if findings else ""))
+
+
 def main() -> None:
     """Console-script entry point: run the app, print user errors as one line."""
     try:

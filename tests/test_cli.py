@@ -158,3 +158,38 @@ def test_maps_generate_bad_parameter(monkeypatch, capsys, tmp_path):
     code, _, err = run_cli(monkeypatch, capsys, "maps", "generate", "warehous", "-o", str(tmp_path))
     assert code == 2
     assert "did you mean 'warehouse'" in " ".join(err.split())
+
+
+def test_scenario_validate(monkeypatch, capsys, tmp_path):
+    good = tmp_path / "ok.json"
+    good.write_text(
+        json.dumps(
+            {
+                "robots": [{"start": [1.0, 1.0, 0.0], "goal": [4.0, 4.0, 0.0]}],
+                "obstacles": {
+                    "static": [{"name": "s1", "model": "shelf", "pos": [2.5, 2.5, 0.0]}],
+                    "dynamic": [
+                        {
+                            "name": "p",
+                            "pos": [3.0, 1.0, 0.0],
+                            "type": "adult",
+                            "waypoints": [[3.0, 4.0, 0.0]],
+                            "waypoint_mode": 2,
+                        }
+                    ],
+                    "interactive": [],
+                },
+            }
+        )
+    )
+    code, out, _ = run_cli(monkeypatch, capsys, "scenario", "validate", str(good))
+    assert code == 0
+    assert "valid" in out and "waypoint_mode" in out  # mode 2 is accepted with a warning
+    bad = tmp_path / "bad.json"
+    bad.write_text(
+        json.dumps({"obstacles": {"static": [{"name": "s", "model": "shelv", "pos": [1, 1, 0]}]}})
+    )
+    code, _, err = run_cli(monkeypatch, capsys, "scenario", "validate", str(bad))
+    assert code == 2
+    flat = " ".join(err.split())
+    assert "bad.json" in flat and "obstacles.static[0].model" in flat and "shelf" in flat

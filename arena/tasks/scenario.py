@@ -1,0 +1,525 @@
+"""Arena scenario JSON files: read, validate, write, and turn into an :class:`Episode`.
+
+The format is Arena-Rosnav's ``worlds/<map>/scenarios/*.json`` (task mode ``scenario``)::
+
+    {"robots": [{"start": [x, y, θ], "goal": [x, y, θ]}],
+     "obstacles": {"static": [...], "interactive": [...], "dynamic": [...]},
+     "map": "arena_corridor", "resets": 50}
+
+Which keys are closed and which pass through follows Arena's own loader and the published files:
+
+* The top level, each robot and the ``obstacles`` block are closed: Arena reads nothing else
+  there, so an unknown key is a spelling mistake and an error. ``map`` and ``resets`` appear in
+  files but Arena's 2024 loader ignores them; they are kept (and written back) as information.
+* Static and interactive obstacles are open: Arena keeps every key beyond ``name``, ``model``
+  and ``pos`` as the obstacle's "extra" (pedsim reads ``type``, ``interaction_radius``,
+  ``yaml_path``). The three known ones are fields; anything else lands in
+  :attr:`ObstacleEntry.extra`, is written back unchanged and is listed in the warnings.
+* Pedestrians (``dynamic``) are closed over the keys Arena's task generator knows (per-ped
+  overrides of the pedsim defaults, see ``Pedestrian``), so a misspelt ``vamx`` is an error
+  instead of a silently ignored override.
+
+Missing keys default as in Arena: lists are empty, positions are ``[0, 0, 0]``, a pedestrian's
+model is ``actor1``, its ``waypoint_mode`` 0 and its ``type`` adult. Positions and waypoints
+may have two values (``[x, y]``, some published files do); the third (θ for poses, a radius
+for waypoints) is then 0. Files are kept as written: a missing key stays missing on save.
+
+Quirks of the published files that load with a recorded warning (:attr:`Scenario.warnings`)
+instead of an error, so that every file Arena ships loads unchanged:
+
+* ``waypoint_mode: 2`` (hospital scenarios) is not defined in pedsim (0 loop, 1 random); it is
+  kept in the file and treated as 0 (loop) when the episode is built.
+* A pedestrian with no waypoints stands at its start position.
+* Legacy model names ending in ``.yaml`` (``shelf.yaml``) name the library model ``shelf``.
+* An unknown pedestrian ``type`` is treated as adult (what Arena's crowd model does).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    Strict,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+    model_validator,
+)
+
+from arena.core.errors import ConfigError, UnknownNameError, from_validation_error
+from arena.core.rng import derive_rng
+from arena.core.types import Pose2D
+from arena.maps.grid import OccupancyGrid
+from arena.maps.obstacles import make_obstacle, obstacle_model
+from arena.robots.model import RobotModel
+from arena.sim.state import Obstacle
+from arena.tasks.episode import (
+    WAYPOINT_LOOP,
+    AgentSpawn,
+    Episode,
+    RobotSpawn,
+)
+
+DEFAULT_VMAX = 0.3
+"""m/s, Arena's task-generator default ``VMAX`` for a pedestrian without a ``vmax`` (§5.3)."""
+DEFAULT_PED_RADIUS = 0.3
+"""m, body radius of a scenario pedestrian (the format has no radius key)."""
+DEFAULT_PED_MODEL = "actor1"
+"""Arena's default pedestrian model name."""
+
+WAYPOINT_UNDEFINED = 2
+"""``waypoint_mode`` 2: used by the hospital scenarios, undefined in pedsim; read as loop."""
+
+KIND_CODES = {"adult": 0, "elder": 1, "child": 2}
+"""Pedestrian ``type`` (with or without the ``human/`` prefix) → :attr:`AgentSpawn.kinds`."""
+
+STARTUP_CODES = {"default": 0, "wait_timer": 1, "trigger_zone": 2}
+"""Arena's ``start_up_mode`` → :attr:`AgentSpawn.startup_mode`."""
+
+# Scalars are strict ("3" is not a number, true is not a count; an int is a fine float), while
+# JSON arrays still fill tuples: the file is parsed with json and validated in lax mode.
+Num = Annotated[float, Strict()]
+Position = Annotated[tuple[Num, ...], Field(min_length=2, max_length=3)]
+"""``[x, y]`` or ``[x, y, θ]`` (m, rad); a missing θ is 0."""
+Waypoint = Annotated[tuple[Num, ...], Field(min_length=2, max_length=3)]
+"""``[x, y]`` or ``[x, y, r]`` (m); Arena forwards ``r`` to pedsim as a radius."""
+Param = Num | Annotated[tuple[Num, Num], Field(description="[lo, hi], sampled")]
+"""A pedsim parameter: a number, or ``[lo, hi]`` sampled from N((lo+hi)/2, (hi−lo)/6) clipped."""
+
+
+# NaN or infinity is never a valid coordinate or parameter (Python's json accepts them).
+_CONFIG = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+
+def _model_name(model: str) -> str:
+    """The library name of an Arena model: legacy ``shelf.yaml`` names the model ``shelf``."""
+    return model.removesuffix(".yaml")
+
+
+def _pose3(pos: Sequence[float]) -> list[float]:
+    return [float(pos[0]), float(pos[1]), float(pos[2]) if len(pos) > 2 else 0.0]
+
+
+class RobotEntry(BaseModel):
+    """One robot of the scenario: start and goal ``[x, y, θ]``."""
+
+    model_config = _CONFIG
+
+    start: Position = (0.0, 0.0, 0.0)
+    goal: Position = (0.0, 0.0, 0.0)
+
+
+class ObstacleEntry(BaseModel):
+    """A static or interactive obstacle.
+
+    Arena keeps every key beyond ``name``/``model``/``pos`` as "extra" data for pedsim, so this
+    entry is open: ``type``, ``interaction_radius`` and ``yaml_path`` (the keys pedsim reads) are
+    fields, any other key is collected into :attr:`extra` and written back unchanged.
+    """
+
+    model_config = _CONFIG
+
+    name: StrictStr
+    model: StrictStr = Field(description="folder name under Arena's entities/obstacles/static/")
+    pos: Position = (0.0, 0.0, 0.0)
+    type: StrictStr | None = None
+    interaction_radius: Num | None = None
+    yaml_path: StrictStr | None = None
+    extra: dict[str, Any] = Field(default_factory=dict, description="other keys, kept as is")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _collect_extra(cls, data: Any) -> Any:
+        if not isinstance(data, dict):
+            return data
+        known = set(cls.model_fields) - {"extra"}
+        out = {k: v for k, v in data.items() if k in known}
+        out["extra"] = {k: v for k, v in data.items() if k not in known}
+        return out
+
+
+class Pedestrian(BaseModel):
+    """A dynamic obstacle (pedsim pedestrian) with Arena's optional per-ped overrides.
+
+    Unset overrides keep Arena's defaults (§5.3). Numbers may also be ``[lo, hi]`` ranges, the
+    way Arena's ``pedsim.yaml`` writes them; they are sampled per episode.
+    """
+
+    model_config = _CONFIG
+
+    name: StrictStr
+    pos: Position = (0.0, 0.0, 0.0)
+    model: StrictStr = DEFAULT_PED_MODEL
+    type: StrictStr = "adult"
+    waypoints: tuple[Waypoint, ...] = ()
+    waypoint_mode: StrictInt = Field(
+        WAYPOINT_LOOP, ge=0, le=2, description="0 loop, 1 random, 2 undefined (read as loop)"
+    )
+    id: StrictInt | None = Field(None, description="present in some files; not used")
+    vmax: Param | None = Field(None, description="m/s")
+    start_up_mode: Literal["default", "wait_timer", "trigger_zone"] | None = None
+    wait_time: Num | None = Field(None, ge=0, description="s, for start_up_mode wait_timer")
+    trigger_zone_radius: Num | None = Field(None, ge=0, description="m, for trigger_zone")
+    chatting_probability: Param | None = None
+    tell_story_probability: Param | None = None
+    group_talking_probability: Param | None = None
+    talking_and_walking_probability: Param | None = None
+    requesting_service_probability: Param | None = None
+    requesting_guide_probability: Param | None = None
+    requesting_follower_probability: Param | None = None
+    max_talking_distance: Param | None = None
+    max_servicing_radius: Param | None = None
+    talking_base_time: Param | None = None
+    tell_story_base_time: Param | None = None
+    group_talking_base_time: Param | None = None
+    talking_and_walking_base_time: Param | None = None
+    receiving_service_base_time: Param | None = None
+    requesting_service_base_time: Param | None = None
+    force_factor_desired: Param | None = None
+    force_factor_obstacle: Param | None = None
+    force_factor_social: Param | None = None
+    force_factor_robot: Param | None = None
+
+    @property
+    def kind(self) -> str:
+        """``adult``/``elder``/``child`` from ``type`` (``human/`` prefix dropped)."""
+        return self.type.removeprefix("human/")
+
+    @property
+    def effective_waypoint_mode(self) -> int:
+        """The mode used in the simulation: the undefined mode 2 runs as loop (0)."""
+        # Validation admits only 0, 1 and 2, so the result is WAYPOINT_LOOP or WAYPOINT_RANDOM.
+        return WAYPOINT_LOOP if self.waypoint_mode == WAYPOINT_UNDEFINED else self.waypoint_mode
+
+
+class Obstacles(BaseModel):
+    """The ``obstacles`` block."""
+
+    model_config = _CONFIG
+
+    static: tuple[ObstacleEntry, ...] = ()
+    interactive: tuple[ObstacleEntry, ...] = ()
+    dynamic: tuple[Pedestrian, ...] = ()
+
+
+class Scenario(BaseModel):
+    """A whole scenario file (see the module docstring for the format and its quirks)."""
+
+    model_config = _CONFIG
+
+    robots: tuple[RobotEntry, ...] = ()
+    obstacles: Obstacles = Field(default_factory=Obstacles)
+    map: StrictStr | None = Field(None, description="informational; the launch arg picks the map")
+    resets: StrictInt | None = Field(None, ge=0, description="informational; not read by Arena")
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Quirks accepted on load, one readable line each (key path first)."""
+        out: list[str] = []
+        for i, r in enumerate(self.robots):
+            for key in ("start", "goal"):
+                if key not in r.model_fields_set:
+                    out.append(f"robots[{i}].{key}: missing, Arena uses [0, 0, 0]")
+        for group in ("static", "interactive"):
+            for i, o in enumerate(getattr(self.obstacles, group)):
+                where = f"obstacles.{group}[{i}]"
+                if o.model != _model_name(o.model):
+                    out.append(
+                        f"{where}.model: legacy name {o.model!r} read as {_model_name(o.model)!r}"
+                    )
+                if o.extra:
+                    keys = ", ".join(sorted(o.extra))
+                    out.append(f"{where}: extra keys kept but not used: {keys}")
+        for i, p in enumerate(self.obstacles.dynamic):
+            where = f"obstacles.dynamic[{i}]"
+            if p.waypoint_mode == WAYPOINT_UNDEFINED:
+                out.append(
+                    f"{where}.waypoint_mode: 2 is undefined in pedsim (0 loop, 1 random); "
+                    "treated as 0 (loop)"
+                )
+            if not p.waypoints:
+                out.append(f"{where}.waypoints: empty; the pedestrian stands at its start")
+            if p.kind not in KIND_CODES:
+                out.append(f"{where}.type: unknown type {p.type!r}, treated as adult")
+        return tuple(out)
+
+    def to_json_dict(self) -> dict[str, Any]:
+        """The file's JSON object: keys missing on load stay missing, extras are flattened."""
+        data = self.model_dump(mode="json", exclude_unset=True)
+        for group in ("static", "interactive"):
+            for entry in data.get("obstacles", {}).get(group, []):
+                entry.update(entry.pop("extra", {}))
+        return data
+
+
+# -- reading and writing ------------------------------------------------------------------------
+def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
+    """Parse and validate scenario JSON text.
+
+    Args:
+        text: the file's content.
+        source: the file name used in error messages.
+
+    Raises:
+        ConfigError: malformed JSON (with line and column), a wrong type or unknown key (with
+            the key path, e.g. ``obstacles.dynamic[3].waypoints``), or an obstacle model that is
+            not in the library (with the closest name).
+    """
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ConfigError(
+            f"malformed JSON at line {e.lineno}, column {e.colno}: {e.msg}", source=source
+        ) from None
+    try:
+        scenario = Scenario.model_validate(data)
+    except ValidationError as e:
+        raise from_validation_error(e, source=source) from None
+    for group in ("static", "interactive"):
+        for i, o in enumerate(getattr(scenario.obstacles, group)):
+            try:
+                obstacle_model(_model_name(o.model))
+            except UnknownNameError as e:
+                raise e.located(source=source, prefix=f"obstacles.{group}[{i}].model") from None
+    return scenario
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read an Arena scenario JSON file (see :func:`parse_scenario` for the errors)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as e:
+        raise ConfigError(f"cannot read scenario file: {e.strerror}", source=str(p)) from None
+    return parse_scenario(text, source=str(p))
+
+
+def save_scenario(scenario: Scenario, path: str | Path) -> None:
+    """Write ``scenario`` in Arena's format (indented JSON); loading it gives an equal value."""
+    text = json.dumps(scenario.to_json_dict(), indent=2)
+    Path(path).write_text(text + "\n", encoding="utf-8")
+
+
+# -- checks against a map -----------------------------------------------------------------------
+def _points(scenario: Scenario) -> list[tuple[str, Sequence[float], bool]]:
+    """Every position of the scenario as (key path, xy, must be free of walls)."""
+    pts: list[tuple[str, Sequence[float], bool]] = []
+    for i, r in enumerate(scenario.robots):
+        pts += [(f"robots[{i}].start", r.start, True), (f"robots[{i}].goal", r.goal, True)]
+    for group in ("static", "interactive"):
+        for i, o in enumerate(getattr(scenario.obstacles, group)):
+            # An obstacle may stand against (or partly in) a wall: only its being on the map
+            # is checked.
+            pts.append((f"obstacles.{group}[{i}].pos", o.pos, False))
+    for i, p in enumerate(scenario.obstacles.dynamic):
+        pts.append((f"obstacles.dynamic[{i}].pos", p.pos, True))
+        for j, w in enumerate(p.waypoints):
+            pts.append((f"obstacles.dynamic[{i}].waypoints[{j}]", w, True))
+    return pts
+
+
+def validate_against_map(
+    scenario: Scenario, grid: OccupancyGrid, *, source: str | None = None
+) -> list[str]:
+    """Check that every position lies on ``grid`` and robots/pedestrians are not in walls.
+
+    Args:
+        scenario: the scenario.
+        grid: the map it runs on.
+        source: the scenario file, for messages.
+
+    Returns:
+        Findings that are not errors (none at present; kept for the CLI's list).
+
+    Raises:
+        ConfigError: led by the first offending entry (e.g. ``obstacles.dynamic[3].waypoints[1]``),
+            followed by every other one.
+    """
+    xmin, ymin, xmax, ymax = grid.bounds
+    problems: list[tuple[str, str]] = []
+    for path, pos, must_be_free in _points(scenario):
+        xy = np.array([float(pos[0]), float(pos[1])])
+        where = f"({xy[0]:g}, {xy[1]:g})"
+        if not bool(grid.contains(xy)):
+            problems.append(
+                (
+                    path,
+                    f"{where} lies outside the map (x in [{xmin:g}, {xmax:g}], "
+                    f"y in [{ymin:g}, {ymax:g}])",
+                )
+            )
+        elif must_be_free and bool(grid.is_occupied(xy)):
+            problems.append((path, f"{where} lies inside a wall of the map"))
+    if problems:
+        # The first problem leads (file and key path first); the rest are listed after it.
+        (path, text), rest = problems[0], problems[1:]
+        more = "".join(f"; {p}: {t}" for p, t in rest)
+        raise ConfigError(text + more, source=source, path=path)
+    return []
+
+
+def validate_file(path: str | Path, map_yaml: str | Path | None = None) -> list[str]:
+    """CLI hook: load a scenario (and check it against a ROS ``map.yaml`` if given).
+
+    Returns:
+        Human-readable findings (warnings), each starting with the file and key path.
+
+    Raises:
+        ConfigError: the first error, naming the file and the entry.
+    """
+    from arena.maps.io import load_map  # map images are only needed when a map is given
+
+    scenario = load_scenario(path)
+    findings = list(scenario.warnings)
+    if map_yaml is not None:
+        findings += validate_against_map(scenario, load_map(map_yaml), source=str(path))
+    return [f"{path}: {w}" for w in findings]
+
+
+# -- conversion to an episode -------------------------------------------------------------------
+def _draw(value: Param | None, default: float, rng: np.random.Generator) -> float:
+    """A number, or Arena's draw from N((lo+hi)/2, (hi−lo)/6) clipped to [lo, hi]."""
+    if value is None:
+        return default
+    if isinstance(value, tuple):
+        lo, hi = value
+        return float(np.clip(rng.normal((lo + hi) / 2, (hi - lo) / 6), lo, hi))
+    return float(value)
+
+
+def _unique(name: str, taken: set[str]) -> str:
+    out, k = name, 2
+    while out in taken:
+        out, k = f"{name}_{k}", k + 1
+    taken.add(out)
+    return out
+
+
+def _agents(peds: Sequence[Pedestrian], rng: np.random.Generator) -> AgentSpawn:
+    n = len(peds)
+    if n == 0:
+        return AgentSpawn.empty()
+    k = max(max(len(p.waypoints) for p in peds), 1)
+    waypoints = np.full((n, k, 2), np.nan)
+    num = np.ones(n, dtype=np.int64)
+    for i, p in enumerate(peds):
+        # No waypoints: the one waypoint is the start, so the pedestrian stays where it is.
+        pts = [w[:2] for w in p.waypoints] or [p.pos[:2]]
+        waypoints[i, : len(pts)] = pts
+        num[i] = len(pts)
+    modes = np.array([p.effective_waypoint_mode for p in peds], dtype=np.int64)
+    custom_start = any(p.start_up_mode not in (None, "default") for p in peds)
+    return AgentSpawn(
+        positions=np.array([p.pos[:2] for p in peds], dtype=np.float64),
+        radii=np.full(n, DEFAULT_PED_RADIUS),
+        vmax=np.array([_draw(p.vmax, DEFAULT_VMAX, rng) for p in peds]),
+        waypoints=waypoints,
+        num_waypoints=num,
+        waypoint_mode=modes,
+        kinds=np.array([KIND_CODES.get(p.kind, 0) for p in peds], dtype=np.int64),
+        startup_mode=np.array(
+            [STARTUP_CODES[p.start_up_mode or "default"] for p in peds], dtype=np.int64
+        )
+        if custom_start
+        else None,
+        wait_time=np.array([p.wait_time or 0.0 for p in peds]) if custom_start else None,
+        trigger_radius=np.array([p.trigger_zone_radius or 0.0 for p in peds])
+        if custom_start
+        else None,
+    )
+
+
+def scenario_episode(
+    scenario: Scenario,
+    grid: OccupancyGrid,
+    robots: Sequence[RobotModel],
+    *,
+    index: int = 0,
+    seed: int = 0,
+    time_limit: float,
+    goal_radius: float = 0.3,
+    map_name: str | None = None,
+) -> Episode:
+    """Build the :class:`Episode` a scenario describes.
+
+    As in Arena, scenario robots beyond ``len(robots)`` are dropped; fewer scenario robots than
+    ``robots`` is an error. Pedestrians get radius :data:`DEFAULT_PED_RADIUS`, ``vmax``
+    :data:`DEFAULT_VMAX` unless set (``[lo, hi]`` ranges are drawn from the episode's seed), and
+    kind codes from ``type``; pedsim-only overrides (force factors, chat probabilities ...) have
+    no counterpart in :class:`AgentSpawn` and are not used.
+
+    Args:
+        scenario: the loaded scenario.
+        grid: the map (not checked here; see :func:`validate_against_map`).
+        robots: the robot models, in scenario order.
+        index: episode number.
+        seed: the episode's seed.
+        time_limit: s.
+        goal_radius: m.
+        map_name: label for reports (default: the scenario's ``map`` key, else ``scenario``).
+
+    Raises:
+        ConfigError: too few robots in the scenario, or an obstacle model not in the library
+            (the message lists the known models).
+    """
+    if len(scenario.robots) < len(robots):
+        raise ConfigError(
+            f"the scenario has {len(scenario.robots)} robot(s) but {len(robots)} robot model(s) "
+            "were given; add start/goal entries or run fewer robots",
+            path="robots",
+        )
+    spawns = tuple(
+        RobotSpawn(
+            f"robot{k}" if len(robots) > 1 else model.name,
+            model,
+            Pose2D.from_array(_pose3(entry.start)),
+            Pose2D.from_array(_pose3(entry.goal)),
+        )
+        for k, (model, entry) in enumerate(zip(robots, scenario.robots, strict=False))
+    )
+    taken: set[str] = set()
+    obstacles: list[Obstacle] = []
+    for group in ("static", "interactive"):
+        for i, o in enumerate(getattr(scenario.obstacles, group)):
+            try:
+                obstacles.append(
+                    make_obstacle(_unique(o.name, taken), _model_name(o.model), _pose3(o.pos))
+                )
+            except UnknownNameError as e:
+                raise e.located(prefix=f"obstacles.{group}[{i}].model") from None
+    rng = derive_rng(seed, "episode", index, "scenario")
+    return Episode(
+        index=index,
+        seed=seed,
+        map_name=map_name or scenario.map or "scenario",
+        grid=grid,
+        obstacles=tuple(obstacles),
+        robots=spawns,
+        agents=_agents(scenario.obstacles.dynamic, rng),
+        time_limit=time_limit,
+        goal_radius=goal_radius,
+    )
+
+
+__all__ = [
+    "DEFAULT_PED_RADIUS",
+    "DEFAULT_VMAX",
+    "ObstacleEntry",
+    "Obstacles",
+    "Pedestrian",
+    "RobotEntry",
+    "Scenario",
+    "load_scenario",
+    "parse_scenario",
+    "save_scenario",
+    "scenario_episode",
+    "validate_against_map",
+    "validate_file",
+]
