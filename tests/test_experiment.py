@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from arena.config import load_config
+from arena.core.errors import ConfigError
 from arena.core.types import Outcome
 from arena.crowd.base import CROWD_MODELS
 from arena.experiment import make_episode, run_episode, run_experiment
@@ -95,3 +96,36 @@ def test_every_crowd_model_runs_an_episode(model, tmp_path):
     agents = np.loadtxt(tmp_path / "episode_000" / "agents.csv", delimiter=",", skiprows=1)
     assert agents.shape[0] == 8 * (res.steps + 1)
     assert np.all(np.isfinite(agents))
+
+
+def test_scenario_task_runs_a_packaged_world(tmp_path):
+    from arena.maps.sources import WORLDS_DIR
+
+    file = WORLDS_DIR / "corridor" / "scenarios" / "default.json"
+    cfg = load_config(
+        None,
+        [
+            "map.name=corridor",
+            "task.type=scenario",
+            f"task.file={file}",
+            "episodes=2",
+            "output.video=false",
+            "task.time_limit=60",
+        ],
+    )
+    _, results = run_experiment(cfg, tmp_path)
+    assert [r.outcome for r in results] == ["success", "success"]
+    assert results[0].start == [-13.5, 0.0, 0.0]  # from the file
+    # The same file every episode: the robot starts at the same pose.
+    assert results[1].start == results[0].start
+
+
+def test_scenario_task_rejects_positions_in_walls(tmp_path):
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"robots": [{"start": [-15.5, 0, 0], "goal": [13, 0, 0]}]}')
+    cfg = load_config(
+        None, ["map.name=corridor", "task.type=scenario", f"task.file={bad}", "output.video=false"]
+    )
+    with pytest.raises(ConfigError, match=r"bad\.json: robots\[0\]\.start"):
+        run_experiment(cfg, tmp_path / "out")
+    assert not (tmp_path / "out").exists()  # failed before writing anything

@@ -162,6 +162,11 @@ def _resolve_relative_paths(data: dict[str, Any], base: Path) -> None:
         p = Path(m["path"]).expanduser()
         if not p.is_absolute() and (base / p).exists():
             m["path"] = str(base / p)
+    task = data.get("task")
+    if isinstance(task, dict) and isinstance(task.get("file"), str):
+        p = Path(task["file"]).expanduser()
+        if not p.is_absolute() and (base / p).exists():
+            task["file"] = str(base / p)
     robot = data.get("robot")
     if isinstance(robot, str) and robot.endswith((".yaml", ".yml")):
         p = Path(robot).expanduser()

@@ -85,6 +85,15 @@ def test_map_generator(name):
 
 
 @pytest.mark.parametrize("name", TASKS.names())
-def test_task(name):
+def test_task(name, tmp_path):
     room = MapResult("room", OccupancyGrid.empty(16.0, 12.0, 0.05))
-    check_task(TASKS.build({"type": name, "min_goal_distance": 4.0}), room)
+    if name == "scenario":
+        file = tmp_path / "s.json"
+        file.write_text(
+            '{"robots": [{"start": [2, 2, 0], "goal": [13, 9, 0]}], "obstacles": {"static": '
+            '[{"name": "b", "model": "cuboid", "pos": [8, 6, 0]}], "dynamic": [{"name": "p", '
+            '"pos": [3, 9, 0], "waypoints": [[12, 3, 0]], "waypoint_mode": 0}]}}'
+        )
+        check_task(TASKS.build({"type": name, "file": str(file)}), room, varies_with_seed=False)
+    else:
+        check_task(TASKS.build({"type": name, "min_goal_distance": 4.0}), room)
