@@ -173,13 +173,6 @@ def _integrate(
     return new_p, new_v
 
 
-def cap_speed(v: FloatArray, vmax: FloatArray) -> FloatArray:
-    """Scale rows of ``v`` ``(n, 2)`` down to at most ``vmax`` ``(n,)`` (m/s); new array."""
-    speed = np.hypot(v[:, 0], v[:, 1])
-    scale = np.where(speed > vmax, vmax / np.maximum(speed, 1e-12), 1.0)
-    return v * scale[:, None]
-
-
 def guard_walls(
     walls: WallIndex,
     p0: FloatArray,
