@@ -34,18 +34,17 @@ import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ArenaError, PlanningError
 from arena.core.rng import derive_rng
-from arena.core.types import Outcome
+from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
 from arena.maps.raster import polygon_mask
-from arena.maps.sources import MAP_SOURCES, MapSource
 from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.sim.backend import BACKENDS, SimulatorBackend
 from arena.sim.state import SimState
-from arena.tasks.base import TASKS, Task
 from arena.tasks.episode import Episode
+from arena.tasks.generator import TaskGenerator, TaskRuntime
 
 
 @dataclass
@@ -74,25 +73,16 @@ def make_episode(
     index: int,
     robot: RobotModel | None = None,
     *,
-    source: MapSource | None = None,
-    task: Task | None = None,
+    generator: TaskGenerator | None = None,
 ) -> Episode:
     """Episode ``index`` of the experiment, drawn deterministically from ``cfg.seed``.
 
-    ``robot``, ``source`` and ``task`` may be passed in to reuse them across episodes (a file
-    map is then read once); they are built from ``cfg`` otherwise.
+    Pass ``generator`` to reuse one across episodes (maps are then built once).
     """
-    robot = robot or load_robot(cfg.robot)
-    source = source or MAP_SOURCES.build(cfg.map, path="map")
-    map_result = source.build(derive_rng(cfg.seed, "episode", index, "map"))
-    task = task or TASKS.build(cfg.task, path="task")
-    return task.sample(
-        map_result,
-        [robot],
-        index=index,
-        seed=cfg.seed,
-        rng=derive_rng(cfg.seed, "episode", index, "task"),
+    generator = generator or TaskGenerator.from_config(
+        cfg, [robot] if robot is not None else None
     )
+    return generator.episode(index)
 
 
 def planning_grid(episode: Episode):
@@ -207,8 +197,16 @@ def run_episode(
     out_dir: Path | None,
     *,
     video: bool = False,
+    runtime: TaskRuntime | None = None,
 ) -> EpisodeResult:
-    """Simulate one episode with the configured navigation stack and write its files."""
+    """Simulate one episode with the configured navigation stack and write its files.
+
+    ``runtime`` decides when goals are reached and what comes next (the generator's
+    :meth:`~arena.tasks.generator.TaskGenerator.runtime`); by default each robot is done when it
+    reaches its goal.
+    """
+    if runtime is None:
+        runtime = TaskRuntime.single_goal(episode)
     t0 = time.perf_counter()
     spawn = episode.robots[0]
     robot = spawn.model
@@ -222,7 +220,6 @@ def run_episode(
     scan_origin = np.array(laser.mount[:2])
     dt = cfg.sim.dt
     goal = spawn.goal
-    goal_radius = episode.goal_radius
 
     recorder = EpisodeRecorder()
     recorder.record(state)
@@ -232,10 +229,14 @@ def run_episode(
     try:
         stack.reset(planning_grid(episode), spawn.start, goal)
         while True:
-            pose = state.robots.poses[0]
-            if math.hypot(goal.x - pose[0], goal.y - pose[1]) < goal_radius:
+            update = runtime.update(state.time, state.robots.poses)
+            if update.done:
                 outcome = Outcome.SUCCESS
                 break
+            if 0 in update.goals:
+                goal = update.goals[0]
+                stack.reset(planning_grid(episode), Pose2D.from_array(state.robots.poses[0]), goal)
+            pose = state.robots.poses[0]
             if state.time >= episode.time_limit - 1e-9:
                 outcome = Outcome.TIMEOUT
                 break
@@ -352,18 +353,26 @@ def run_experiment(
     """Run every episode of ``cfg`` and write the outputs under ``out_dir``."""
     robot = load_robot(cfg.robot)
     backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
-    source = MAP_SOURCES.build(cfg.map, path="map")
-    task = TASKS.build(cfg.task, path="task")
+    generator = TaskGenerator.from_config(cfg, [robot])
+    n_episodes = generator.num_episodes or cfg.episodes
     # Draw the first episode before writing anything: a bad map or task fails with no output.
-    first = make_episode(cfg, 0, robot, source=source, task=task)
+    first = generator.episode(0)
     out = Path(out_dir or cfg.output.dir or default_output_dir(cfg))
     out.mkdir(parents=True, exist_ok=True)
     (out / "config.yaml").write_text(yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False))
     results = []
-    for i in range(cfg.episodes):
-        episode = first if i == 0 else make_episode(cfg, i, robot, source=source, task=task)
+    for i in range(n_episodes):
+        episode = first if i == 0 else generator.episode(i)
         video = cfg.output.video and i < cfg.output.video_episodes
-        res = run_episode(cfg, episode, backend, out / f"episode_{i:03d}", video=video)
+        res = run_episode(
+            cfg,
+            episode,
+            backend,
+            out / f"episode_{i:03d}",
+            video=video,
+            runtime=generator.runtime(episode),
+        )
+        generator.feedback(i, res.outcome)
         results.append(res)
         if on_episode:
             on_episode(res)

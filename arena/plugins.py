@@ -11,8 +11,9 @@ import arena.maps.sources
 import arena.nav
 import arena.robots
 import arena.sim.native2d
-import arena.tasks.random_task
-import arena.tasks.scenario_task  # noqa: F401
+import arena.tasks.modules
+import arena.tasks.obstacle_modes
+import arena.tasks.robot_modes  # noqa: F401
 from arena.core.registry import all_registries
 
 __all__ = ["all_registries"]

@@ -17,10 +17,10 @@ from tests.conftest import make_episode as hand_episode
 
 FAST = [
     "output.video=false",
-    "task.agents=6",
-    "task.obstacles=2",
-    "task.time_limit=20",
-    "task.min_goal_distance=6",
+    "task.obstacles.dynamic=6",
+    "task.obstacles.static=2",
+    "task.timeout=20",
+    "task.robots.min_goal_distance=6",
     "episodes=2",
 ]
 
@@ -48,7 +48,9 @@ def test_episodes_differ_within_a_run():
 
 
 def test_success_is_reached_goal(tmp_path):
-    cfg = load_config(None, [*FAST, "task.agents=0", "task.obstacles=0", "task.time_limit=60"])
+    cfg = load_config(
+        None, [*FAST, "task.obstacles.dynamic=0", "task.obstacles.static=0", "task.timeout=60"]
+    )
     _, results = run_experiment(cfg, tmp_path)
     for r in results:
         assert r.outcome == Outcome.SUCCESS
@@ -71,7 +73,7 @@ def test_enclosed_goal_is_a_planner_failure():
 
 
 def test_timeout(tmp_path):
-    cfg = load_config(None, [*FAST, "robot=burger", "task.time_limit=2", "episodes=1"])
+    cfg = load_config(None, [*FAST, "robot=burger", "task.timeout=2", "episodes=1"])
     _, (res,) = run_experiment(cfg, tmp_path)
     assert res.outcome == Outcome.TIMEOUT
     assert abs(res.time - 2.0) < 1e-6
@@ -83,9 +85,9 @@ def test_every_crowd_model_runs_an_episode(model, tmp_path):
         None,
         [
             f"crowd.type={model}",
-            "task.agents=8",
-            "task.obstacles=1",
-            "task.time_limit=6",
+            "task.obstacles.dynamic=8",
+            "task.obstacles.static=1",
+            "task.timeout=6",
             "output.video=false",
             "pedestrians.initial_levels=random",
         ],
@@ -106,11 +108,13 @@ def test_scenario_task_runs_a_packaged_world(tmp_path):
         None,
         [
             "map.name=corridor",
-            "task.type=scenario",
-            f"task.file={file}",
+            "task.robots.type=scenario",
+            f"task.robots.file={file}",
+            "task.obstacles.type=scenario",
+            f"task.obstacles.file={file}",
             "episodes=2",
             "output.video=false",
-            "task.time_limit=60",
+            "task.timeout=60",
         ],
     )
     _, results = run_experiment(cfg, tmp_path)
@@ -124,7 +128,13 @@ def test_scenario_task_rejects_positions_in_walls(tmp_path):
     bad = tmp_path / "bad.json"
     bad.write_text('{"robots": [{"start": [-15.5, 0, 0], "goal": [13, 0, 0]}]}')
     cfg = load_config(
-        None, ["map.name=corridor", "task.type=scenario", f"task.file={bad}", "output.video=false"]
+        None,
+        [
+            "map.name=corridor",
+            "task.robots.type=scenario",
+            f"task.robots.file={bad}",
+            "output.video=false",
+        ],
     )
     with pytest.raises(ConfigError, match=r"bad\.json: robots\[0\]\.start"):
         run_experiment(cfg, tmp_path / "out")

@@ -155,6 +155,10 @@ def _apply(data: dict[str, Any], key: str, value: Any, text: str) -> dict[str, A
     return merge(data, _nest(key, value))
 
 
+TASK_FILE_KEYS = ("file", "zones", "scenario", "suite", "curriculum")
+"""Keys of task mode/module blocks that hold file paths (resolved relative to the config)."""
+
+
 def _resolve_relative_paths(data: dict[str, Any], base: Path) -> None:
     """Make file paths in a config file relative to that file, as users expect."""
     m = data.get("map")
@@ -163,10 +167,18 @@ def _resolve_relative_paths(data: dict[str, Any], base: Path) -> None:
         if not p.is_absolute() and (base / p).exists():
             m["path"] = str(base / p)
     task = data.get("task")
-    if isinstance(task, dict) and isinstance(task.get("file"), str):
-        p = Path(task["file"]).expanduser()
-        if not p.is_absolute() and (base / p).exists():
-            task["file"] = str(base / p)
+    if isinstance(task, dict):
+        blocks = [task.get("robots"), task.get("obstacles")]
+        if isinstance(task.get("modules"), list):
+            blocks += task["modules"]
+        for block in blocks:
+            if not isinstance(block, dict):
+                continue
+            for key in TASK_FILE_KEYS:
+                if isinstance(block.get(key), str):
+                    p = Path(block[key]).expanduser()
+                    if not p.is_absolute() and (base / p).exists():
+                        block[key] = str(base / p)
     robot = data.get("robot")
     if isinstance(robot, str) and robot.endswith((".yaml", ".yml")):
         p = Path(robot).expanduser()
@@ -183,10 +195,13 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
     from arena.nav.local_planners.base import LOCAL_PLANNERS
     from arena.robots.presets import load_robot
     from arena.sim.backend import BACKENDS
-    from arena.tasks.base import TASKS
+    from arena.tasks.base import validate_mode
 
     MAP_SOURCES.validate(cfg.map, source=source, path="map")
-    TASKS.validate(cfg.task, source=source, path="task")
+    validate_mode("robots", cfg.task.robots, source=source, path="task.robots")
+    validate_mode("obstacles", cfg.task.obstacles, source=source, path="task.obstacles")
+    for i, module in enumerate(cfg.task.modules):
+        validate_mode("modules", module, source=source, path=f"task.modules[{i}]")
     CROWD_MODELS.validate(cfg.crowd, source=source, path="crowd")
     BACKENDS.validate(cfg.sim.backend, source=source, path="sim.backend")
     GLOBAL_PLANNERS.validate(

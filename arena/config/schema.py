@@ -1,8 +1,9 @@
 """The experiment config: one pydantic model for everything ``arena run`` needs.
 
-Polymorphic blocks (``map``, ``task``, ``crowd``, ``navigation.*_planner``, ``sim.backend``)
-are flat mappings ``{type: name, **params}``; :func:`arena.config.loader.validate_plugins`
-checks each against its registry so that every error names the file and the key path.
+Polymorphic blocks (``map``, ``task.robots|obstacles|modules``, ``crowd``,
+``navigation.*_planner``, ``sim.backend``) are flat mappings ``{type: name, **params}``;
+:func:`arena.config.loader.validate_plugins` checks each against its registry so that every
+error names the file and the key path.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.simulator import PedestrianConfig
 from arena.nav.stack import NavigationConfig
+from arena.tasks.config import TaskConfig
 
 
 class _Strict(BaseModel):
@@ -51,9 +53,7 @@ class ExperimentConfig(_Strict):
         default_factory=lambda: {"type": "world", "name": "small_office"},
         description="{type: map source, ...params}",
     )
-    task: dict[str, Any] = Field(
-        default_factory=lambda: {"type": "random"}, description="{type: task, ...params}"
-    )
+    task: TaskConfig = Field(default_factory=TaskConfig)
     crowd: dict[str, Any] = Field(
         default_factory=lambda: {"type": "pysocial"}, description="{type: crowd model, ...}"
     )

@@ -6,6 +6,7 @@ all draws happened in the generator, so an episode is a plain, reproducible valu
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -101,6 +102,8 @@ class Episode:
         agents: the pedestrians.
         time_limit: seconds of simulated time before the episode ends as a timeout.
         goal_radius: the goal counts as reached within this distance (m).
+        goal_tolerance_angle: and with the heading within this (rad); ``None`` ignores heading.
+        label: where the episode comes from (a benchmark stage, a curriculum stage), for reports.
     """
 
     index: int
@@ -112,3 +115,31 @@ class Episode:
     agents: AgentSpawn
     time_limit: float
     goal_radius: float = 0.3
+    goal_tolerance_angle: float | None = None
+    label: str = ""
+
+
+def episode_digest(episode: Episode) -> str:
+    """A short SHA-1 over everything that defines an episode (map, robots, obstacles, people).
+
+    Two episodes with the same digest are the same episode; ``arena tasks preview`` prints it
+    so two machines can compare what a suite will run.
+    """
+    h = hashlib.sha1()
+    g = episode.grid
+    h.update(np.ascontiguousarray(g.data).tobytes())
+    h.update(np.array([g.resolution, *g.origin], dtype=np.float64).tobytes())
+    for r in episode.robots:
+        h.update(r.name.encode())
+        h.update(r.model.name.encode())
+        h.update(np.concatenate([r.start.as_array(), r.goal.as_array()]).tobytes())
+    for o in episode.obstacles:
+        h.update(o.name.encode())
+        h.update(np.asarray(o.pose, dtype=np.float64).tobytes())
+        h.update(np.asarray(o.footprint, dtype=np.float64).tobytes())
+    a = episode.agents
+    for arr in (a.positions, a.radii, a.vmax, a.waypoints, a.num_waypoints, a.waypoint_mode,
+                a.kinds, a.groups, a.startup_mode, a.wait_time, a.trigger_radius):
+        h.update(b"-" if arr is None else np.ascontiguousarray(arr).tobytes())
+    h.update(repr((episode.time_limit, episode.goal_radius, episode.goal_tolerance_angle)).encode())
+    return h.hexdigest()[:12]

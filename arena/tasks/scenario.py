@@ -402,7 +402,8 @@ def _unique(name: str, taken: set[str]) -> str:
     return out
 
 
-def _agents(peds: Sequence[Pedestrian], rng: np.random.Generator) -> AgentSpawn:
+def scenario_agents(peds: Sequence[Pedestrian], rng: np.random.Generator) -> AgentSpawn:
+    """The scenario's dynamic obstacles as pedestrians (``vmax`` ranges drawn from ``rng``)."""
     n = len(peds)
     if n == 0:
         return AgentSpawn.empty()
@@ -434,6 +435,26 @@ def _agents(peds: Sequence[Pedestrian], rng: np.random.Generator) -> AgentSpawn:
         if custom_start
         else None,
     )
+
+
+def scenario_obstacles(scenario: Scenario) -> list[Obstacle]:
+    """The scenario's static and interactive obstacles with library footprints.
+
+    Raises:
+        UnknownNameError: a model not in the obstacle library, naming the entry
+            (``obstacles.static[2].model``) and the known models.
+    """
+    taken: set[str] = set()
+    obstacles: list[Obstacle] = []
+    for group in ("static", "interactive"):
+        for i, o in enumerate(getattr(scenario.obstacles, group)):
+            try:
+                obstacles.append(
+                    make_obstacle(_unique(o.name, taken), _model_name(o.model), _pose3(o.pos))
+                )
+            except UnknownNameError as e:
+                raise e.located(prefix=f"obstacles.{group}[{i}].model") from None
+    return obstacles
 
 
 def scenario_episode(
@@ -484,16 +505,7 @@ def scenario_episode(
         )
         for k, (model, entry) in enumerate(zip(robots, scenario.robots, strict=False))
     )
-    taken: set[str] = set()
-    obstacles: list[Obstacle] = []
-    for group in ("static", "interactive"):
-        for i, o in enumerate(getattr(scenario.obstacles, group)):
-            try:
-                obstacles.append(
-                    make_obstacle(_unique(o.name, taken), _model_name(o.model), _pose3(o.pos))
-                )
-            except UnknownNameError as e:
-                raise e.located(prefix=f"obstacles.{group}[{i}].model") from None
+    obstacles = scenario_obstacles(scenario)
     rng = derive_rng(seed, "episode", index, "scenario")
     return Episode(
         index=index,
@@ -502,7 +514,7 @@ def scenario_episode(
         grid=grid,
         obstacles=tuple(obstacles),
         robots=spawns,
-        agents=_agents(scenario.obstacles.dynamic, rng),
+        agents=scenario_agents(scenario.obstacles.dynamic, rng),
         time_limit=time_limit,
         goal_radius=goal_radius,
     )
@@ -519,7 +531,9 @@ __all__ = [
     "load_scenario",
     "parse_scenario",
     "save_scenario",
+    "scenario_agents",
     "scenario_episode",
+    "scenario_obstacles",
     "validate_against_map",
     "validate_file",
 ]

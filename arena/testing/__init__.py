@@ -7,7 +7,7 @@ from arena.testing.conformance import (
     check_backend,
     check_crowd_model,
     check_map_source,
-    check_task,
+    check_task_mode,
 )
 
-__all__ = ["check_backend", "check_crowd_model", "check_map_source", "check_task"]
+__all__ = ["check_backend", "check_crowd_model", "check_map_source", "check_task_mode"]

@@ -9,7 +9,6 @@ from arena.maps.grid import OccupancyGrid
 from arena.maps.sources import MapResult, MapSource
 from arena.robots.presets import load_robot
 from arena.sim.state import RobotStates, SimState, StaticWorld
-from arena.tasks.base import Task
 from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn, Episode, RobotSpawn
 
 
@@ -178,26 +177,62 @@ def check_map_source(source: MapSource) -> None:
     assert isinstance(a.name, str) and a.name, "a map needs a name"
 
 
-def check_task(task: Task, map_result: MapResult, *, varies_with_seed: bool = True) -> None:
-    """A task samples valid episodes deterministically.
+def check_task_mode(
+    role: str,
+    spec: dict,
+    map_spec: dict | None = None,
+    *,
+    varies_with_seed: bool = True,
+    episodes: int = 3,
+) -> None:
+    """A task mode (or module) yields valid episodes deterministically.
 
-    ``varies_with_seed``: different seeds must give different starts/goals (False for tasks that
-    replay a fixed scenario).
+    Builds a :class:`~arena.tasks.generator.TaskGenerator` with ``spec`` in ``role`` (the
+    other roles at their defaults, with few obstacles) and checks: same seed → same episodes
+    (digests), another seed → other episodes (unless ``varies_with_seed`` is False), robots
+    start and end with their body clear of walls, obstacles and people inside the map's free
+    space, positive time limits, and that ``next_goal`` answers a goal in free space or ``None``.
     """
+    from arena.tasks.config import TaskConfig
+    from arena.tasks.episode import episode_digest
+    from arena.tasks.generator import TaskGenerator
+    from arena.tasks.world import WorldSampler
+
     jackal = load_robot("jackal")
+    blocks: dict = {"obstacles": {"type": "random", "static": 2, "dynamic": 3}}
+    if role == "modules":
+        blocks["modules"] = [spec]
+    else:
+        blocks[role] = spec
+    cfg = TaskConfig.model_validate(blocks)
+    map_spec = map_spec or {"type": "empty", "width": 16.0, "height": 12.0}
 
-    def draw(seed: int) -> Episode:
-        return task.sample(
-            map_result, [jackal], index=0, seed=seed, rng=np.random.default_rng(seed)
-        )
+    def make(seed: int) -> TaskGenerator:
+        return TaskGenerator(cfg, map_spec=map_spec, robots=[jackal], seed=seed)
 
-    a, b, c = draw(1), draw(1), draw(2)
-    assert isinstance(a, Episode), "sample must return an Episode"
-    assert a.robots[0].start == b.robots[0].start and a.robots[0].goal == b.robots[0].goal
-    assert np.array_equal(a.agents.positions, b.agents.positions), "same seed, same agents"
+    a, b, c = make(1), make(1), make(2)
+    eps = [a.episode(i) for i in range(episodes)]
+    assert [episode_digest(e) for e in eps] == [
+        episode_digest(b.episode(i)) for i in range(episodes)
+    ], "same seed, same episodes"
     if varies_with_seed:
-        assert (a.robots[0].start, a.robots[0].goal) != (c.robots[0].start, c.robots[0].goal)
-    for spawn in a.robots:
-        for pose in (spawn.start, spawn.goal):
-            assert not map_result.grid.is_occupied(pose.xy), "start and goal in free space"
-    assert a.time_limit > 0
+        assert [episode_digest(e) for e in eps] != [
+            episode_digest(c.episode(i)) for i in range(episodes)
+        ], "another seed, other episodes"
+    for ep in eps:
+        assert isinstance(ep, Episode)
+        assert ep.time_limit > 0 and ep.goal_radius > 0
+        world = WorldSampler(ep.grid, ep.obstacles)
+        for spawn in ep.robots:
+            for pose in (spawn.start, spawn.goal):
+                d = world.clearance(pose.xy[None])[0]
+                assert d >= spawn.model.radius - 1e-9, f"robot body clear of walls ({d:.3f} m)"
+        if len(ep.agents):
+            assert np.all(world.wall_distance(ep.agents.positions) > 0), "people in free space"
+        runtime = a.runtime(ep)
+        rng = np.random.default_rng(0)
+        nxt = runtime.ctx.robot_mode.next_goal(runtime.ctx, 0, ep.robots[0].goal, rng)
+        assert nxt is None or isinstance(nxt, Pose2D)
+        if nxt is not None:
+            assert world.wall_distance(nxt.xy[None])[0] > 0, "next goal in free space"
+        a.feedback(ep.index, "success")

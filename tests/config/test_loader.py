@@ -21,13 +21,16 @@ def test_packaged_default_loads():
 
 
 def test_overrides_are_typed_and_nested():
-    cfg = load_config(None, ["robot=burger", "seed=3", "task.agents=4", "output.video=false",
-                             "task.agent_speed=[0.4, 0.9]"])
+    cfg = load_config(
+        None,
+        ["robot=burger", "seed=3", "task.obstacles.dynamic=4", "output.video=false",
+         "task.obstacles.agent_speed=[0.4, 0.9]"],
+    )
     assert cfg.robot == "burger"
     assert cfg.seed == 3
-    assert cfg.task["agents"] == 4
+    assert cfg.task.obstacles["dynamic"] == 4
     assert cfg.output.video is False
-    assert cfg.task["agent_speed"] == [0.4, 0.9]
+    assert cfg.task.obstacles["agent_speed"] == [0.4, 0.9]
 
 
 def test_changing_a_plugin_type_replaces_the_block():
@@ -50,12 +53,12 @@ def test_file_merges_over_defaults_and_relative_paths(tmp_path):
 
 
 def test_misspelt_key_in_file_names_file_and_path(tmp_path):
-    p = write(tmp_path, "seed: 1\ntask:\n  type: random\n  agnets: 3\n")
+    p = write(tmp_path, "seed: 1\ntask:\n  obstacles:\n    type: random\n    agnets: 3\n")
     with pytest.raises(ConfigError) as info:
         load_config(p)
     msg = str(info.value)
     assert str(p) in msg
-    assert "task.agnets" in msg
+    assert "task.obstacles.agnets" in msg
     assert "unknown key" in msg
 
 
@@ -73,8 +76,8 @@ def test_wrong_type_names_expected(tmp_path):
 
 def test_override_errors_blame_the_override():
     with pytest.raises(ConfigError) as info:
-        load_config(None, ["task.agnets=3"])
-    assert "override 'task.agnets=3'" in str(info.value)
+        load_config(None, ["task.obstacles.agnets=3"])
+    assert "override 'task.obstacles.agnets=3'" in str(info.value)
     with pytest.raises(ConfigError, match="override 'seed=-1'"):
         load_config(None, ["seed=-1"])
     with pytest.raises(ConfigError, match=r"key\.path=value"):

@@ -10,17 +10,17 @@ from arena.crowd.base import CROWD_MODELS
 from arena.crowd.simulator import CrowdSimulator
 from arena.maps.generators import MAP_GENERATORS
 from arena.maps.grid import OccupancyGrid
-from arena.maps.sources import MAP_SOURCES, MapResult
+from arena.maps.sources import MAP_SOURCES
 from arena.sim.backend import BACKENDS
-from arena.tasks.base import TASKS
-from arena.testing import check_backend, check_crowd_model, check_map_source, check_task
+from arena.tasks.base import TASK_MODES
+from arena.testing import check_backend, check_crowd_model, check_map_source, check_task_mode
 
 # Registry kind -> where its conformance test lives.
 COVERED = {
     "simulator backend": "here",
     "crowd model": "here",
     "map source": "here",
-    "task": "here",
+    "task mode": "here",
     "kinematics": "tests/robots/test_kinematics.py",
     "global planner": "tests/conformance/test_planners_conformance.py",
     "local planner": "tests/conformance/test_planners_conformance.py",
@@ -84,16 +84,28 @@ def test_map_generator(name):
                 assert not polygons_overlap(a, b), f"{name}: overlapping obstacles (seed {seed})"
 
 
-@pytest.mark.parametrize("name", TASKS.names())
-def test_task(name, tmp_path):
-    room = MapResult("room", OccupancyGrid.empty(16.0, 12.0, 0.05))
-    if name == "scenario":
+SCENARIO = (
+    '{"robots": [{"start": [2, 2, 0], "goal": [13, 9, 0]}], "obstacles": {"static": '
+    '[{"name": "b", "model": "cuboid", "pos": [8, 6, 0]}], "dynamic": [{"name": "p", '
+    '"pos": [3, 9, 0], "waypoints": [[12, 3, 0]], "waypoint_mode": 0}]}}'
+)
+
+
+def _mode_spec(name: str, tmp_path) -> tuple[dict, bool]:
+    """A working block for task mode ``role.name`` and whether its episodes vary with the seed.
+
+    Modes that need files get small ones written here; every other mode must run on defaults.
+    """
+    short = name.split(".", 1)[1]
+    if short == "scenario":
         file = tmp_path / "s.json"
-        file.write_text(
-            '{"robots": [{"start": [2, 2, 0], "goal": [13, 9, 0]}], "obstacles": {"static": '
-            '[{"name": "b", "model": "cuboid", "pos": [8, 6, 0]}], "dynamic": [{"name": "p", '
-            '"pos": [3, 9, 0], "waypoints": [[12, 3, 0]], "waypoint_mode": 0}]}}'
-        )
-        check_task(TASKS.build({"type": name, "file": str(file)}), room, varies_with_seed=False)
-    else:
-        check_task(TASKS.build({"type": name, "min_goal_distance": 4.0}), room)
+        file.write_text(SCENARIO)
+        return {"type": short, "file": str(file)}, True  # the other role stays random
+    return {"type": short}, True
+
+
+@pytest.mark.parametrize("name", TASK_MODES.names())
+def test_task_mode(name, tmp_path):
+    role = name.split(".", 1)[0]
+    spec, varies = _mode_spec(name, tmp_path)
+    check_task_mode(role, spec, varies_with_seed=varies)

@@ -1,0 +1,144 @@
+import itertools
+
+import numpy as np
+import pytest
+from pydantic import ValidationError
+
+from arena.core.errors import SamplingError
+from arena.maps.grid import OccupancyGrid
+from arena.maps.io import save_map
+from arena.nav.global_planners.astar import AStarPlanner
+from arena.robots.presets import load_robot
+from arena.sim.native2d.collisions import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
+from arena.sim.state import StaticWorld
+from arena.tasks.config import TaskConfig
+from arena.tasks.episode import episode_digest
+from arena.tasks.generator import TaskGenerator
+from arena.tasks.obstacle_modes.random import RandomObstacles
+from arena.tasks.sampling import line_of_sight
+from arena.tasks.world import WorldSampler
+
+OFFICE = {"type": "world", "name": "small_office"}
+
+
+def generator(robots=None, obstacles=None, map_spec=OFFICE, seed=0, robot="jackal"):
+    cfg = TaskConfig(robots=robots or {"type": "random"}, obstacles=obstacles or {"type": "random"})
+    return TaskGenerator(cfg, map_spec=map_spec, robots=[load_robot(robot)], seed=seed)
+
+
+def test_same_seed_same_episode_different_seed_differs():
+    obstacles = {"type": "random", "static": 3, "dynamic": 8}
+    a = generator(obstacles=obstacles).episode(0)
+    b = generator(obstacles=obstacles).episode(0)
+    c = generator(obstacles=obstacles, seed=1).episode(0)
+    assert episode_digest(a) == episode_digest(b)
+    assert np.array_equal(a.agents.waypoints, b.agents.waypoints, equal_nan=True)
+    assert a.robots[0].start != c.robots[0].start
+    assert episode_digest(a) != episode_digest(generator(obstacles=obstacles).episode(1))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_constraints_hold(seed):
+    robots = {"type": "random", "min_goal_distance": 8.0}
+    obstacles = {"type": "random", "static": 5, "dynamic": 10}
+    ep = generator(robots, obstacles, seed=seed).episode(0)
+    p = RandomObstacles.Params(**{k: v for k, v in obstacles.items() if k != "type"})
+    jackal = load_robot("jackal")
+    world = StaticWorld.build(ep.grid, ep.obstacles)
+    fp = Footprint.make(jackal.footprint_polygon(), jackal.circumscribed_radius)
+    idx = ObstacleIndex.build(world)
+    exact = WorldSampler(ep.grid, ep.obstacles)
+    r = ep.robots[0]
+    for pose in (r.start.as_array(), r.goal.as_array()):
+        assert not hits_grid(ep.grid, fp, pose)
+        assert first_obstacle_hit(idx, fp, pose) == -1
+        assert exact.clearance(pose[None, :2])[0] >= jackal.radius + 0.25
+    assert r.start.distance_to(r.goal) >= 8.0
+    from arena.experiment import planning_grid
+
+    path = AStarPlanner().plan(planning_grid(ep).inflate(jackal.radius), r.start, r.goal)
+    assert len(path) >= 2
+    # Placed obstacles keep their gap from walls and from each other.
+    placed = [o for o in ep.obstacles if o.name.startswith("S_")]
+    assert len(placed) == 5
+    for a in placed:
+        others = WorldSampler(ep.grid, [o for o in ep.obstacles if o is not a])
+        gap = others.clearance(a.polygon).min()
+        assert gap >= p.obstacle_clearance - 1e-9
+    ag = ep.agents
+    assert len(ag) == 10
+    assert np.all(np.hypot(*(ag.positions - r.start.xy).T) > p.agent_robot_clearance)
+    walkable = ep.grid.distance > 0
+    for i in range(len(ag)):
+        pts = np.vstack([ag.positions[i], ag.waypoints[i, : ag.num_waypoints[i]]])
+        for a, b in itertools.pairwise(pts):
+            assert line_of_sight(ep.grid, walkable, a, b)
+        assert np.allclose(pts[-1], ag.positions[i])  # round trip ends where it started
+    assert np.all((ag.vmax >= 0.5) & (ag.vmax <= 1.2))
+
+
+def test_counts_are_drawn_from_the_range():
+    obstacles = {"type": "random", "static": [1, 4], "dynamic": {"min": 2, "max": 6}}
+    g = generator(obstacles=obstacles)
+    statics, people = set(), set()
+    for i in range(30):
+        ep = g.episode(i)
+        statics.add(sum(o.name.startswith("S_") for o in ep.obstacles))
+        people.add(len(ep.agents))
+    assert statics == {1, 2, 3, 4}
+    assert min(people) >= 2 and max(people) <= 6 and len(people) >= 4
+
+
+def test_library_models_and_interactive_obstacles():
+    obstacles = {
+        "type": "random",
+        "static": {"min": 2, "max": 2, "models": ["shelf", "table"]},
+        "interactive": {"min": 1, "max": 1, "models": ["chair"]},
+        "dynamic": 0,
+    }
+    ep = generator(obstacles=obstacles).episode(0)
+    names = [o.name for o in ep.obstacles]
+    assert sum(n.startswith("S_") for n in names) == 2
+    assert any(n == "I_chair_1" for n in names)
+    assert {o.model for o in ep.obstacles if o.name.startswith("S_")} <= {"shelf", "table"}
+
+
+def test_impossible_request_fails_clearly():
+    tiny = {"type": "empty", "width": 3.0, "height": 3.0}
+    far = {"type": "random", "min_goal_distance": 10.0}
+    with pytest.raises(SamplingError, match="min_goal_distance"):
+        generator(far, {"type": "random", "static": 0, "dynamic": 0}, map_spec=tiny).episode(0)
+    crowded = {"type": "random", "static": 40, "dynamic": 0, "obstacle_clearance": 1.0}
+    near = {"type": "random", "min_goal_distance": 1.0}
+    with pytest.raises(SamplingError, match="obstacle"):
+        generator(near, crowded, map_spec=tiny).episode(0)
+
+
+def test_params_validation():
+    with pytest.raises(ValidationError, match="agent_speed"):
+        RandomObstacles.Params(agent_speed=(1.0, 0.5))
+    with pytest.raises(ValidationError):
+        RandomObstacles.Params(agnets=3)  # type: ignore[call-arg]
+    with pytest.raises(ValidationError, match="min"):
+        RandomObstacles.Params(static=[5, 2])
+    with pytest.raises(ValidationError, match="unknown obstacle model"):
+        RandomObstacles.Params(static={"min": 1, "max": 1, "models": ["shelff"]})
+
+
+def test_never_samples_in_unknown_space(tmp_path):
+    data = np.full((200, 240), -1, dtype=np.int8)
+    data[40:160, 40:200] = 0
+    data[40, 40:200] = data[159, 40:200] = 100
+    data[40:160, 40] = data[40:160, 199] = 100
+    grid = OccupancyGrid(data, 0.05)
+    save_map(grid, tmp_path / "room.yaml")
+    spec = {"type": "file", "path": str(tmp_path / "room.yaml")}
+    robots = {"type": "random", "min_goal_distance": 2.0}
+    obstacles = {"type": "random", "static": 2, "dynamic": 6}
+    for seed in range(5):
+        ep = generator(robots, obstacles, map_spec=spec, seed=seed, robot="burger").episode(0)
+        pts = [ep.robots[0].start.xy, ep.robots[0].goal.xy, *ep.agents.positions]
+        pts += [o.pose[:2] for o in ep.obstacles]
+        pts += list(ep.agents.waypoints.reshape(-1, 2))
+        cells = grid.world_to_cell(np.array(pts))
+        assert np.all(grid.data[cells[:, 0], cells[:, 1]] == 0)

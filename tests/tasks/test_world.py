@@ -1,0 +1,96 @@
+import numpy as np
+import pytest
+
+from arena.core.errors import SamplingError
+from arena.core.geometry import point_segment_distance, points_in_polygon
+from arena.maps.generators import MAP_GENERATORS
+from arena.maps.grid import OccupancyGrid
+from arena.maps.obstacles import make_obstacle
+from arena.tasks.world import WorldSampler, polygon_distance
+
+
+def brute_wall_distance(grid: OccupancyGrid, pts: np.ndarray) -> np.ndarray:
+    """Exact distance from points to every non-free cell square and to the map border."""
+    rows, cols = np.nonzero(~grid.free)
+    res = grid.resolution
+    lo = np.stack([grid.origin[0] + cols * res, grid.origin[1] + rows * res], axis=1)
+    out = []
+    x0, y0, x1, y1 = grid.bounds
+    for p in pts:
+        dx = np.maximum(np.maximum(lo[:, 0] - p[0], p[0] - (lo[:, 0] + res)), 0)
+        dy = np.maximum(np.maximum(lo[:, 1] - p[1], p[1] - (lo[:, 1] + res)), 0)
+        border = min(p[0] - x0, x1 - p[0], p[1] - y0, y1 - p[1])
+        out.append(min(float(np.hypot(dx, dy).min()) if len(lo) else np.inf, border))
+    return np.array(out)
+
+
+def test_polygon_distance_reference_values():
+    square = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], dtype=float)
+    pts = np.array([[1, 1], [3, 1], [3, 3], [-1, 1], [1, 2.5]])
+    assert np.allclose(polygon_distance(pts, square), [0, 1, np.sqrt(2), 1, 0.5])
+
+
+def test_sampled_positions_respect_clearances_over_1000_samples():
+    """Walls, obstacles and forbidden zones, checked against brute-force exact distances."""
+    grid = MAP_GENERATORS.build({"type": "barn", "width": 15.0, "height": 10.0}).build(
+        np.random.default_rng(3)
+    ).grid
+    obstacles = [make_obstacle(f"t{i}", "table", [3 + 3 * i, 5.0, 0.0]) for i in range(3)]
+    world = WorldSampler(grid, obstacles)
+    world.forbid([7.5, 2.0], 1.0)
+    zone = np.array([[11.0, 6.0], [13.0, 6.0], [13.0, 8.0], [11.0, 8.0]])
+    world.forbid_polygon(zone)
+    rng = np.random.default_rng(0)
+    pts, clearances = [], []
+    for _ in range(200):
+        c = float(rng.uniform(0.1, 0.5))
+        pts.append(world.sample(5, c, rng, what="points", forbid=False))
+        clearances += [c] * 5
+    pts, clear = np.concatenate(pts), np.array(clearances)
+    assert len(pts) == 1000
+    assert np.all(brute_wall_distance(grid, pts) >= clear)
+    for o in obstacles:
+        poly = o.polygon
+        d = point_segment_distance(pts, poly, np.roll(poly, -1, axis=0)).min(axis=1)
+        assert not points_in_polygon(pts, poly).any()
+        assert np.all(d >= clear)
+    assert np.all(np.hypot(*(pts - [7.5, 2.0]).T) >= 1.0 + clear)
+    assert not points_in_polygon(pts, zone).any()
+    assert np.all(polygon_distance(pts, zone) >= clear)
+    # Positions sampled in one call keep 2·clearance from each other.
+    batch = world.sample(30, 0.4, rng, what="people")
+    d = np.hypot(*(batch[:, None] - batch[None]).transpose(2, 0, 1))
+    assert np.all(d[np.triu_indices(30, 1)] >= 0.8)
+    # ... and with forbid=True later positions keep away from them.
+    later = world.sample(50, 0.2, rng, what="more")
+    assert np.all(np.hypot(*(later[:, None] - batch[None]).transpose(2, 0, 1)) >= 0.6)
+
+
+def test_wall_distance_is_exact():
+    grid = MAP_GENERATORS.build({"type": "barn", "width": 10.0, "height": 8.0}).build(
+        np.random.default_rng(1)
+    ).grid
+    rng = np.random.default_rng(2)
+    pts = rng.uniform([0.5, 0.5], [9.5, 7.5], size=(300, 2))
+    world = WorldSampler(grid)
+    assert np.allclose(world.wall_distance(pts), brute_wall_distance(grid, pts), atol=1e-12)
+
+
+def test_impossible_request_raises_never_places_outside():
+    grid = OccupancyGrid.empty(2.0, 2.0, 0.05)
+    world = WorldSampler(grid)
+    with pytest.raises(SamplingError, match=r"cannot place 5 robots: found room for \d of 5"):
+        world.sample(5, 0.6, np.random.default_rng(0), what="5 robots")
+    # Inside a polygon zone only.
+    zone = np.array([[0.5, 0.5], [1.5, 0.5], [1.5, 1.5], [0.5, 1.5]])
+    pts = world.sample(3, 0.1, np.random.default_rng(1), what="x", polygon=zone)
+    assert points_in_polygon(pts, zone).all()
+
+
+def test_clear_forbidden():
+    world = WorldSampler(OccupancyGrid.empty(4.0, 4.0, 0.05))
+    world.forbid([2.0, 2.0], 2.5)
+    with pytest.raises(SamplingError):
+        world.sample(1, 0.3, np.random.default_rng(0), what="x")
+    world.clear_forbidden()
+    assert world.sample(1, 0.3, np.random.default_rng(0), what="x").shape == (1, 2)
