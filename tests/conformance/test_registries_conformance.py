@@ -91,21 +91,23 @@ SCENARIO = (
 )
 
 
-def _mode_spec(name: str, tmp_path) -> tuple[dict, bool]:
-    """A working block for task mode ``role.name`` and whether its episodes vary with the seed.
+def _scenario_file(tmp_path):
+    file = tmp_path / "s.json"
+    file.write_text(SCENARIO)
+    return {"file": str(file)}
 
-    Modes that need files get small ones written here; every other mode must run on defaults.
-    """
-    short = name.split(".", 1)[1]
-    if short == "scenario":
-        file = tmp_path / "s.json"
-        file.write_text(SCENARIO)
-        return {"type": short, "file": str(file)}, True  # the other role stays random
-    return {"type": short}, True
+
+# Task modes that need parameters (files, a world with zones ...): name -> factory(tmp_path)
+# returning (extra params, map block or None for the default empty room). Every other mode
+# must run on its defaults.
+MODE_PARAMS = {
+    "robots.scenario": lambda tmp: (_scenario_file(tmp), None),
+    "obstacles.scenario": lambda tmp: (_scenario_file(tmp), None),
+}
 
 
 @pytest.mark.parametrize("name", TASK_MODES.names())
 def test_task_mode(name, tmp_path):
-    role = name.split(".", 1)[0]
-    spec, varies = _mode_spec(name, tmp_path)
-    check_task_mode(role, spec, varies_with_seed=varies)
+    role, short = name.split(".", 1)
+    params, map_spec = MODE_PARAMS.get(name, lambda tmp: ({}, None))(tmp_path)
+    check_task_mode(role, {"type": short, **params}, map_spec)
