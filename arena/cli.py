@@ -48,8 +48,25 @@ def run(
     seed: Annotated[int | None, typer.Option(help="master seed")] = None,
     out: Annotated[Path | None, typer.Option("--out", "-o", help="output folder")] = None,
     video: Annotated[bool | None, typer.Option("--video/--no-video", help="write videos")] = None,
+    scenario: Annotated[
+        Path | None,
+        typer.Option("--scenario", help="Arena scenario JSON: robots and obstacles from the file"),
+    ] = None,
+    interactive: Annotated[
+        bool,
+        typer.Option(
+            "--interactive",
+            help="real time; read commands from stdin: goal X Y [TH], teleport X Y [TH], reset, "
+            "quit",
+        ),
+    ] = False,
 ) -> None:
-    """Run episodes: a robot drives to its goals among people; writes videos and trajectories."""
+    """Run episodes: a robot drives to its goals among people; writes videos and trajectories.
+
+    With ``--interactive`` the simulation runs in real time and reads one command per stdin
+    line: ``goal X Y [TH]`` (new goal), ``teleport X Y [TH]`` (move the robot), ``reset`` (end
+    the episode), ``quit`` (stop reading); ``robot=I`` picks another robot.
+    """
     from arena.config import load_config
     from arena.experiment import run_experiment
 
@@ -71,7 +88,23 @@ def run(
             items += ["map.type=file", f"map.path={p.resolve()}"]
         else:
             items += ["map.type=world", f"map.name={p.resolve() if p.is_dir() else map_}"]
+    if scenario is not None:
+        if not scenario.is_file():
+            raise ArenaError(f"--scenario: no such file {str(scenario)!r}")
+        import json
+
+        block = json.dumps({"type": "scenario", "file": str(scenario.resolve())})
+        items += [f"task.robots={block}", f"task.obstacles={block}"]
     cfg = load_config(path, items)
+    extra_modules = []
+    if interactive:
+        from arena.tasks.modules.interactive import InteractiveModule
+
+        ui = InteractiveModule(
+            on_error=lambda msg: err_console.print(f"error: {msg}", highlight=False)
+        )
+        extra_modules.append(ui)
+        _read_commands(ui)
 
     table = Table(title=f"arena run · {cfg.name}", show_lines=False)
     for col in ("episode", "outcome", "time [s]", "path [m]", "collisions", "wall [s]"):
@@ -98,13 +131,43 @@ def run(
             f"{res.wall_time:.1f}",
         )
 
-    out_dir, results = run_experiment(cfg, out, on_episode=show)
+    out_dir, results = run_experiment(
+        cfg, out, on_episode=show, modules=extra_modules, realtime=interactive
+    )
     console.print(table)
     console.print(f"results:     {out_dir}/summary.csv")
     for res in results:
         for kind in ("video", "trajectory"):
             if kind in res.files:
                 console.print(f"{kind + ':':12} {res.files[kind]}")
+
+
+def _read_commands(ui) -> None:
+    """Feed stdin lines to the interactive module from a daemon thread (errors: one line)."""
+    import threading
+
+    from arena.tasks.modules.interactive import CommandError, parse_command
+
+    def loop() -> None:
+        ui.ready.wait()  # validate against the first episode's map
+        for line in sys.stdin:
+            if not line.strip():
+                continue
+            try:
+                cmd = parse_command(line)
+                if cmd is None:
+                    return
+                if cmd.kind == "reset":
+                    ui.reset()
+                elif cmd.kind == "goal":
+                    ui.set_goal(cmd.robot, cmd.pose)
+                else:
+                    ui.teleport(cmd.robot, cmd.pose)
+                err_console.print(f"ok: {line.strip()}", highlight=False)
+            except CommandError as e:
+                err_console.print(f"error: {e}", highlight=False, soft_wrap=True)
+
+    threading.Thread(target=loop, name="arena-stdin", daemon=True).start()
 
 
 @app.command()
@@ -222,6 +285,87 @@ def scenario_validate(
     for line in findings:
         console.print(f"[yellow]warning:[/] {line}", highlight=False)
     console.print(f"{path}: valid" + (f" ({len(findings)} warning(s))" if findings else ""))
+
+
+tasks_app = typer.Typer(help="Task modes, benchmark suites and curricula.", no_args_is_help=True)
+app.add_typer(tasks_app, name="tasks")
+
+
+@tasks_app.command("list")
+def tasks_list() -> None:
+    """List the task modes by role (robots, obstacles, modules) with their summaries."""
+    import arena.plugins  # noqa: F401
+    from arena.tasks.base import ROLES, TASK_MODES, mode_names
+    from arena.tasks.datafiles import packaged
+
+    table = Table(title="Task modes  (task.robots / task.obstacles / task.modules)")
+    table.add_column("role")
+    table.add_column("name")
+    table.add_column("description")
+    for role in ROLES:
+        for i, name in enumerate(mode_names(role)):
+            entry = TASK_MODES.entry(f"{role}.{name}")
+            table.add_row(role if i == 0 else "", name, entry.summary)
+        table.add_section()
+    console.print(table)
+    console.print("packaged suites: " + ", ".join(packaged("suites")))
+    console.print("packaged curricula: " + ", ".join(packaged("curricula")))
+    console.print("packaged contests: " + ", ".join(packaged("contests")))
+
+
+@tasks_app.command("preview")
+def tasks_preview(
+    suite: Annotated[str, typer.Argument(help="packaged suite name (paper, quick) or YAML path")],
+    seed: Annotated[int, typer.Option(help="run seed")] = 0,
+    scale: Annotated[float, typer.Option(help="scale_episodes: factor on every stage")] = 1.0,
+    contest: Annotated[
+        str | None, typer.Option(help="packaged contest name or YAML path")
+    ] = None,
+) -> None:
+    """Draw every episode of a suite and print a table (no simulation)."""
+    from arena.config.schema import ExperimentConfig
+    from arena.robots.presets import load_robot
+    from arena.tasks.config import TaskConfig
+    from arena.tasks.episode import episode_digest
+    from arena.tasks.generator import TaskGenerator
+    from arena.tasks.suite import contestant_config, load_contest
+
+    base = ExperimentConfig(seed=seed)
+    task = TaskConfig.model_validate(
+        {"modules": [{"type": "benchmark", "suite": suite, "scale_episodes": scale}]}
+    )
+    gen = TaskGenerator(task, map_spec=base.map, robots=[load_robot(base.robot)], seed=seed)
+    contestants = []
+    if contest is not None:
+        file, source = load_contest(contest)
+        for i, c in enumerate(file.contestants):
+            contestant_config(base, c, source=source, index=i)  # checks the planner names
+            contestants.append(c)
+    bench = gen.modules[0]
+    table = Table(title=f"suite {suite} · seed {seed} · scale {scale:g}")
+    for col in ("stage", "ep", "map", "robot", "start", "goal", "obstacles", "peds", "digest"):
+        table.add_column(col, justify="right" if col in ("ep", "obstacles", "peds") else "left")
+    total_obs = total_peds = 0
+    n = gen.num_episodes or 0
+    for ep in gen.episodes(n):
+        _, k = bench.stage_of(ep.index)
+        r = ep.robots[0]
+        total_obs += len(ep.obstacles)
+        total_peds += len(ep.agents)
+        table.add_row(
+            ep.label, str(k), ep.map_name, r.model.name,
+            f"({r.start.x:.1f}, {r.start.y:.1f})", f"({r.goal.x:.1f}, {r.goal.y:.1f})",
+            str(len(ep.obstacles)), str(len(ep.agents)), episode_digest(ep)[:10],
+        )
+    console.print(table)
+    stages = sum(1 for c in bench.suite.episode_counts if c > 0)
+    console.print(
+        f"total: {n} episodes in {stages} stages, {total_obs} obstacles, {total_peds} pedestrians"
+    )
+    if contestants:
+        names = ", ".join(f"{c.name} ({c.local_planner} + {c.inter_planner})" for c in contestants)
+        console.print(f"contest: {len(contestants)} contestants x {n} episodes = "
+                      f"{len(contestants) * n} runs: {names}")
 
 
 def main() -> None:

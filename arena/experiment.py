@@ -22,10 +22,11 @@ import csv
 import json
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from datetime import datetime
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import yaml
@@ -65,6 +66,8 @@ class EpisodeResult:
     final_goal_distance: float
     wall_time: float
     error: str = ""
+    goals_reached: int = 0
+    teleports: int = 0
     files: dict[str, str] = field(default_factory=dict)
 
 
@@ -198,12 +201,22 @@ def run_episode(
     *,
     video: bool = False,
     runtime: TaskRuntime | None = None,
+    realtime: bool = False,
 ) -> EpisodeResult:
     """Simulate one episode with the configured navigation stack and write its files.
 
     ``runtime`` decides when goals are reached and what comes next (the generator's
     :meth:`~arena.tasks.generator.TaskGenerator.runtime`); by default each robot is done when it
-    reaches its goal.
+    reaches its goal. Every step its update is applied: teleports move the robot (backend
+    ``teleport``, the stack plans afresh), new goals make the stack replan, and a forced reset
+    ends the episode as ``aborted``. ``realtime`` paces the loop to ``dt`` of wall time per
+    step (interactive runs).
+
+    The stack's goal tolerances follow the episode: position within ``0.9 · goal_radius`` (or
+    the navigation config's, if smaller) and, when the task checks the heading
+    (``goal_tolerance_angle``), the heading too; robots that can turn on the spot then align
+    their heading at the goal. Car-like (Ackermann) robots cannot, so a heading tolerance is
+    met by them only when the approach ends with it.
     """
     if runtime is None:
         runtime = TaskRuntime.single_goal(episode)
@@ -214,6 +227,9 @@ def run_episode(
     crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
     state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
     stack = NavigationStack.from_config(cfg.navigation, robot_radius=robot.radius)
+    stack.goal_tolerance_xy = min(stack.goal_tolerance_xy, 0.9 * episode.goal_radius)
+    if episode.goal_tolerance_angle is not None:
+        stack.goal_tolerance_yaw = float(episode.goal_tolerance_angle)
     limits = robot.limits()
     laser = robot.laser
     angles = laser.angles() + laser.mount[2]
@@ -226,16 +242,30 @@ def run_episode(
     states = [state] if video else []
     outcome, error = Outcome.TIMEOUT, ""
     collisions, touching = 0, False
+    jumps: list[int] = []  # recorder rows reached by a teleport (not driven)
+    wall_start = time.perf_counter()
     try:
         stack.reset(planning_grid(episode), spawn.start, goal)
         while True:
-            update = runtime.update(state.time, state.robots.poses)
+            update = runtime.update(state.time, state.robots.poses, state.agents.positions)
+            if update.reset:
+                outcome = Outcome.ABORTED
+                break
             if update.done:
                 outcome = Outcome.SUCCESS
                 break
+            for i, target in sorted(update.teleports.items()):
+                state = backend.teleport(i, target)
+                if i == 0:
+                    jumps.append(len(recorder.robot_rows))
+                    touching = bool(state.collisions.any[0])
             if 0 in update.goals:
                 goal = update.goals[0]
-                stack.reset(planning_grid(episode), Pose2D.from_array(state.robots.poses[0]), goal)
+            if 0 in update.goals or 0 in update.teleports:
+                stack.reset(
+                    planning_grid(episode), Pose2D.from_array(state.robots.poses[0]), goal,
+                    time=state.time,
+                )
             pose = state.robots.poses[0]
             if state.time >= episode.time_limit - 1e-9:
                 outcome = Outcome.TIMEOUT
@@ -257,6 +287,10 @@ def run_episode(
             cmd = np.asarray(stack.step(obs), dtype=np.float64)
             if cmd.shape != (3,) or not np.all(np.isfinite(cmd)):
                 raise ArenaError(f"the navigation stack returned an invalid command {cmd!r}")
+            if realtime:
+                ahead = wall_start + state.time + dt - time.perf_counter()
+                if ahead > 0:
+                    time.sleep(ahead)
             state = backend.step(cmd[None, :], dt)
             recorder.record(state)
             if video:
@@ -270,9 +304,11 @@ def run_episode(
         outcome, error = Outcome.ERROR, f"{type(e).__name__}: {e}"
 
     poses = recorder.poses
-    path_length = (
-        float(np.sum(np.hypot(*np.diff(poses[:, :2], axis=0).T))) if len(poses) > 1 else 0.0
-    )
+    steps = np.hypot(*np.diff(poses[:, :2], axis=0).T) if len(poses) > 1 else np.zeros(0)
+    for row in jumps:  # a teleport is no distance driven
+        if 0 < row <= len(steps):
+            steps[row - 1] = 0.0
+    path_length = float(np.sum(steps))
     final = poses[-1]
     result = EpisodeResult(
         index=idx,
@@ -289,6 +325,8 @@ def run_episode(
         final_goal_distance=float(math.hypot(goal.x - final[0], goal.y - final[1])),
         wall_time=0.0,
         error=error,
+        goals_reached=runtime.goals_reached[0],
+        teleports=runtime.teleports[0],
     )
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -349,11 +387,23 @@ def run_experiment(
     out_dir: Path | None = None,
     *,
     on_episode: Callable[[EpisodeResult], None] | None = None,
+    modules: Sequence[Any] = (),
+    realtime: bool = False,
 ) -> tuple[Path, list[EpisodeResult]]:
-    """Run every episode of ``cfg`` and write the outputs under ``out_dir``."""
+    """Run every episode of ``cfg`` and write the outputs under ``out_dir``.
+
+    Args:
+        cfg: the experiment.
+        out_dir: output folder (default: ``output.dir`` or ``runs/<name>_<time>``).
+        on_episode: called with each finished episode's result.
+        modules: task module instances added after the config's (the CLI's interactive
+            module, which it feeds from stdin).
+        realtime: pace the simulation to wall-clock time (interactive runs).
+    """
     robot = load_robot(cfg.robot)
     backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
     generator = TaskGenerator.from_config(cfg, [robot])
+    generator.modules.extend(modules)
     n_episodes = generator.num_episodes or cfg.episodes
     # Draw the first episode before writing anything: a bad map or task fails with no output.
     first = generator.episode(0)
@@ -371,6 +421,7 @@ def run_experiment(
             out / f"episode_{i:03d}",
             video=video,
             runtime=generator.runtime(episode),
+            realtime=realtime,
         )
         generator.feedback(i, res.outcome)
         results.append(res)
@@ -391,6 +442,8 @@ def _write_summary(path: Path, results: list[EpisodeResult]) -> None:
         "steps",
         "path_length",
         "collisions",
+        "goals_reached",
+        "teleports",
         "final_goal_distance",
         "wall_time",
         "error",

@@ -193,3 +193,29 @@ def test_scenario_validate(monkeypatch, capsys, tmp_path):
     assert code == 2
     flat = " ".join(err.split())
     assert "bad.json" in flat and "obstacles.static[0].model" in flat and "shelf" in flat
+
+
+def test_tasks_list_and_preview(monkeypatch, capsys):
+    code, out, _ = run_cli(monkeypatch, capsys, "tasks", "list")
+    assert code == 0
+    for name in ("random", "scenario", "staged", "benchmark", "dynamic_map"):
+        assert name in out
+    monkeypatch.setattr(cli.console, "width", 200)
+    code, out, _ = run_cli(monkeypatch, capsys, "tasks", "preview", "quick", "--seed", "3",
+                           "--contest", "basic")
+    assert code == 0, out
+    assert "corridor_scenario" in out and "canteen" in out
+    assert "total: 6 episodes in 3 stages" in out
+    assert "1 contestants x 6 episodes" in out
+    code, out2, _ = run_cli(monkeypatch, capsys, "tasks", "preview", "quick", "--seed", "3",
+                            "--scale", "2")
+    assert code == 0 and "total: 12 episodes" in out2
+
+
+def test_tasks_preview_errors_are_one_line(monkeypatch, capsys, tmp_path):
+    code, _, err = run_cli(monkeypatch, capsys, "tasks", "preview", "nosuch")
+    assert code == 2 and err.startswith("error:") and "packaged" in err
+    bad = tmp_path / "s.yaml"
+    bad.write_text("stages:\n  - {name: x, episodes: 1, map: atlantis}\n")
+    code, _, err = run_cli(monkeypatch, capsys, "tasks", "preview", str(bad))
+    assert code == 2 and "stages[0].map" in err and str(bad) in err.replace("\n", "")

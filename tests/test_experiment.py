@@ -7,7 +7,7 @@ import pytest
 
 from arena.config import load_config
 from arena.core.errors import ConfigError
-from arena.core.types import Outcome
+from arena.core.types import Outcome, Pose2D
 from arena.crowd.base import CROWD_MODELS
 from arena.experiment import make_episode, run_episode, run_experiment
 from arena.maps.grid import OccupancyGrid
@@ -139,3 +139,27 @@ def test_scenario_task_rejects_positions_in_walls(tmp_path):
     with pytest.raises(ConfigError, match=r"bad\.json: robots\[0\]\.start"):
         run_experiment(cfg, tmp_path / "out")
     assert not (tmp_path / "out").exists()  # failed before writing anything
+
+
+@pytest.mark.parametrize("robot", ["jackal", "burger"])
+def test_heading_tolerance_is_met_by_aligning_at_the_goal(robot):
+    from dataclasses import replace
+
+    grid = OccupancyGrid.empty(8.0, 6.0, 0.05)
+    ep = hand_episode(grid, [(load_robot(robot), (1.5, 3.0, 0.0), (4.5, 3.0, 3.0))])
+    ep = replace(ep, goal_tolerance_angle=0.5236, time_limit=60.0)
+    cfg = load_config(None, ["output.video=false"])
+    res = run_episode(cfg, ep, Native2DBackend(), None)
+    assert res.outcome == Outcome.SUCCESS
+    assert res.final_goal_distance < ep.goal_radius
+
+
+def test_teleport_moves_the_robot_at_rest():
+    from arena.testing.conformance import standard_episode
+
+    backend = Native2DBackend()
+    backend.reset(standard_episode(0), None, np.random.default_rng(0))
+    s = backend.step(np.array([[1.0, 0.0, 0.5], [0.2, 0.0, 0.0]]), 0.1)
+    t = backend.teleport(0, Pose2D(5.0, 5.0, 1.0))
+    assert np.allclose(t.robots.poses[0], [5.0, 5.0, 1.0]) and np.allclose(t.robots.twists[0], 0)
+    assert t.time == s.time and not t.collisions.any[0]

@@ -87,6 +87,8 @@ class Outcome(enum.StrEnum):
     """The navigation stack reported that no path exists."""
     ERROR = "error"
     """A planner or the simulator raised, or produced non-finite values."""
+    ABORTED = "aborted"
+    """The episode was ended early by a forced reset (interactive control)."""
 
 
 def wrap_angle_scalar(a: float) -> float:

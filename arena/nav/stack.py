@@ -24,8 +24,11 @@ Policies (documented here because tasks and metrics depend on them):
 - **Replanning** happens every ``replan_period`` seconds (0 = never) and whenever the robot is
   more than ``max_path_deviation`` from the path (pushed by a pedestrian, say).
 - **Goal reached** when within ``goal_tolerance_xy`` and, if ``goal_tolerance_yaw`` is set, with
-  the heading within it too (enable the local planner's heading alignment then, e.g.
-  ``align_goal_heading`` of pure pursuit). The status then stays ``GOAL_REACHED``.
+  the heading within it too; the stack then passes the tolerance to the local planner
+  (``LocalObservation.goal_yaw_tolerance``), and planners that can turn on the spot (pure
+  pursuit) align the heading at the goal. Car-like (Ackermann) robots cannot turn on the spot:
+  they reach a goal heading only if the approach happens to end with it. The status then stays
+  ``GOAL_REACHED``.
 """
 
 from __future__ import annotations
@@ -350,6 +353,11 @@ class NavigationStack:
         local_obs = dataclasses.replace(
             obs, path=self._path, goal=self.goal,
             kinematics=obs.kinematics if obs.kinematics is not None else self.kinematics,
+            goal_yaw_tolerance=(
+                obs.goal_yaw_tolerance
+                if obs.goal_yaw_tolerance is not None
+                else self.goal_tolerance_yaw
+            ),
         )
         return np.asarray(self.local_planner.compute(local_obs), dtype=np.float64).reshape(3)
 

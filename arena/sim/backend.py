@@ -16,6 +16,7 @@ from arena.core.registry import Registry
 from arena.sim.state import AgentStates, RobotStates, SimState, StaticWorld
 
 if TYPE_CHECKING:
+    from arena.core.types import Pose2D
     from arena.tasks.episode import AgentSpawn, Episode
 
 
@@ -58,6 +59,14 @@ class SimulatorBackend(Protocol):
 
     def step(self, commands: NDArray[np.float64], dt: float) -> SimState:
         """Apply ``(r, 3)`` body-twist commands for ``dt`` seconds and return the new snapshot."""
+        ...
+
+    def teleport(self, robot: int, pose: Pose2D) -> SimState:
+        """Move robot ``robot`` to ``pose`` (m, rad) at once, at rest; return the new snapshot.
+
+        Time and step do not advance; the robot's twist and command become zero, and its
+        contacts and sensor readings are those at the new pose.
+        """
         ...
 
 

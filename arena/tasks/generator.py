@@ -209,7 +209,22 @@ class TaskUpdate:
 
 
 class TaskRuntime:
-    """Per-step goal logic of one running episode: arrival checks and new goals.
+    """Per-step goal logic of one running episode: arrivals, new goals, timeouts, commands.
+
+    Optional robot-mode hooks it uses (besides :meth:`~arena.tasks.base.RobotMode.next_goal`):
+
+    - ``goal_timeout`` (s or ``None``) and ``on_goal_timeout(ctx, robot, rng, avoid) ->
+      (pose, goal)``: a robot that has not reached its goal within ``goal_timeout`` seconds is
+      teleported to ``pose`` with the new ``goal`` (``robots.explore``).
+    - ``add_goal(ctx, robot, goal) -> Pose2D | None``: a goal set by a user is handed to the mode
+      (``robots.guided`` appends it to its waypoint list) instead of replacing the robot's goal;
+      the answer, if any, is the robot's new goal.
+    - ``on_teleport(ctx, robot, pose) -> Pose2D``: the robot's goal after a user teleport
+      (``robots.guided`` clears its list and idles there); without it the goal is kept.
+
+    A robot whose goal equals the pose it just reached (or whose goal is its start) is *idle*:
+    it counts no arrivals and waits for a new goal; it is not done. Modules with a
+    ``poll(time) -> list[TaskCommand]`` method (``modules.interactive``) feed commands.
 
     Args:
         ctx: the episode's reset context (``None`` for a hand-built episode: single goals).
@@ -225,23 +240,44 @@ class TaskRuntime:
         self.modules = list(modules)
         self.goals = [r.goal for r in episode.robots]
         self.done = [False] * len(episode.robots)
+        self.idle = [r.goal == r.start for r in episode.robots]
         self.goals_reached = [0] * len(episode.robots)
         self.goal_since = [0.0] * len(episode.robots)
+        self.teleports = [0] * len(episode.robots)
         self.rng = ctx.rng("runtime") if ctx is not None else derive_rng(episode.seed, "runtime")
+        mode: Any = ctx.robot_mode if ctx is not None else None
+        timeout = getattr(mode, "goal_timeout", None)
+        self.goal_timeout: float | None = (
+            float(timeout) if timeout is not None and hasattr(mode, "on_goal_timeout") else None
+        )
+        for m in self.modules:
+            bind = getattr(m, "bind", None)
+            if callable(bind):
+                bind(episode)
 
     @classmethod
-    def single_goal(cls, episode: Episode) -> TaskRuntime:
+    def single_goal(cls, episode: Episode, *, modules: Sequence[Any] = ()) -> TaskRuntime:
         """For an episode built by hand: each robot is done when it reaches its goal."""
-        return cls(None, episode)
+        return cls(None, episode, modules=modules)
 
-    def update(self, time: float, poses: np.ndarray) -> TaskUpdate:
-        """Check arrivals at ``time`` for ``(n_robots, 3)`` ``poses``."""
+    def update(
+        self, time: float, poses: np.ndarray, agents: np.ndarray | None = None
+    ) -> TaskUpdate:
+        """Check arrivals and timeouts at ``time`` (s), then apply module commands.
+
+        Args:
+            time: simulated time (s).
+            poses: ``(n_robots, 3)`` robot poses.
+            agents: optional ``(k, 2)`` pedestrian positions (m); timeout teleports avoid them.
+        """
         upd = TaskUpdate()
         ep = self.episode
-        for i, pose_arr in enumerate(np.asarray(poses, dtype=np.float64).reshape(-1, 3)):
-            if self.done[i]:
+        mode: Any = self.ctx.robot_mode if self.ctx is not None else None
+        arr = np.asarray(poses, dtype=np.float64).reshape(-1, 3)
+        current = [Pose2D.from_array(a) for a in arr]
+        for i, pose in enumerate(current):
+            if self.done[i] or self.idle[i]:
                 continue
-            pose = Pose2D.from_array(pose_arr)
             if goal_reached(pose, self.goals[i], ep.goal_radius, ep.goal_tolerance_angle):
                 self.goals_reached[i] += 1
                 upd.reached.append(i)
@@ -252,9 +288,71 @@ class TaskRuntime:
                 )
                 if nxt is None:
                     self.done[i] = True
-                else:
-                    self.goals[i] = nxt
+                elif nxt == self.goals[i]:
+                    self.idle[i] = True
                     self.goal_since[i] = time
-                    upd.goals[i] = nxt
+                else:
+                    self._set_goal(upd, i, nxt, time)
+            elif (
+                self.goal_timeout is not None
+                and self.ctx is not None
+                and time - self.goal_since[i] >= self.goal_timeout - 1e-9
+            ):
+                others = [arr[j, :2] for j in range(len(arr)) if j != i]
+                if agents is not None and len(agents):
+                    others += list(np.asarray(agents, dtype=np.float64).reshape(-1, 2))
+                avoid = np.array(others).reshape(-1, 2)
+                start, goal = mode.on_goal_timeout(self.ctx, i, self.rng, avoid)
+                upd.teleports[i] = start
+                self.teleports[i] += 1
+                self._set_goal(upd, i, goal, time)
+        for m in self.modules:
+            poll = getattr(m, "poll", None)
+            if callable(poll):
+                for cmd in poll(time):
+                    self._apply(upd, cmd, time)
         upd.done = all(self.done)
         return upd
+
+    def _set_goal(self, upd: TaskUpdate, i: int, goal: Pose2D, time: float) -> None:
+        self.goals[i] = goal
+        self.goal_since[i] = time
+        self.done[i] = False
+        self.idle[i] = False
+        upd.goals[i] = goal
+
+    def _apply(self, upd: TaskUpdate, cmd: Any, time: float) -> None:
+        """Apply one interactive command (``TaskCommand``) to the running episode."""
+        from arena.tasks.modules.interactive import CommandError
+
+        if cmd.kind == "reset":
+            upd.reset = True
+            return
+        i = int(cmd.robot)
+        if not 0 <= i < len(self.goals):
+            raise CommandError(f"{cmd.kind}: no robot {i} (the episode has {len(self.goals)})")
+        mode: Any = self.ctx.robot_mode if self.ctx is not None else None
+        if cmd.kind == "teleport":
+            upd.teleports[i] = cmd.pose
+            self.teleports[i] += 1
+            on_teleport = getattr(mode, "on_teleport", None)
+            if callable(on_teleport):
+                goal = on_teleport(self.ctx, i, cmd.pose)
+                self._set_goal(upd, i, goal, time)
+                self.idle[i] = goal == cmd.pose
+            else:
+                self.goal_since[i] = time
+            return
+        add_goal = getattr(mode, "add_goal", None)
+        if callable(add_goal):
+            nxt = add_goal(self.ctx, i, cmd.pose)
+            # Every idle robot of the mode wakes up to the new waypoint list.
+            for j in range(len(self.goals)):
+                if j == i and nxt is not None:
+                    self._set_goal(upd, j, nxt, time)
+                elif j != i and self.idle[j] and self.ctx is not None:
+                    g = mode.next_goal(self.ctx, j, self.goals[j], self.rng)
+                    if g is not None and g != self.goals[j]:
+                        self._set_goal(upd, j, g, time)
+        else:
+            self._set_goal(upd, i, cmd.pose, time)

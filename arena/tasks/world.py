@@ -82,23 +82,32 @@ class WorldSampler:
         self._forbidden_discs: list[ForbiddenDisc] = []
         self._forbidden_polygons: list[FloatArray] = []
         self._blocked_cache: NDArray[np.bool_] | None = None
+        self._free_cache: NDArray[np.intp] | None = None
         self.add_obstacles(obstacles)
 
     # -- layers --------------------------------------------------------------------------------
     def add_obstacles(self, obstacles: Sequence[Obstacle]) -> None:
         """Add obstacle footprints to the obstacle layer."""
-        self._polygons.extend(np.asarray(o.polygon, dtype=np.float64) for o in obstacles)
-        self._blocked_cache = None
+        polys = [np.asarray(o.polygon, dtype=np.float64) for o in obstacles]
+        self._polygons.extend(polys)
+        if self._blocked_cache is not None and polys:  # update in place: O(new shapes)
+            self._blocked_cache |= polygon_mask(self.grid, polys)
 
     def forbid(self, xy: Sequence[float] | FloatArray, radius: float) -> None:
         """Add a forbidden disc (Arena adds every robot start and goal this way)."""
-        self._forbidden_discs.append(ForbiddenDisc(float(xy[0]), float(xy[1]), float(radius)))
-        self._blocked_cache = None
+        zone = ForbiddenDisc(float(xy[0]), float(xy[1]), float(radius))
+        self._forbidden_discs.append(zone)
+        if self._blocked_cache is not None:
+            self._blocked_cache |= disk_mask(
+                self.grid, np.array([[zone.x, zone.y]]), np.array([zone.radius])
+            )
 
     def forbid_polygon(self, polygon: FloatArray) -> None:
         """Add a forbidden polygon (m)."""
-        self._forbidden_polygons.append(np.asarray(polygon, dtype=np.float64))
-        self._blocked_cache = None
+        poly = np.asarray(polygon, dtype=np.float64)
+        self._forbidden_polygons.append(poly)
+        if self._blocked_cache is not None:
+            self._blocked_cache |= polygon_mask(self.grid, [poly])
 
     def clear_forbidden(self) -> None:
         """Empty the forbidden layer (module ``clear_forbidden_zones``)."""
@@ -243,19 +252,29 @@ class WorldSampler:
         """
         if n <= 0:
             return np.zeros((0, 2))
-        mask = self.candidate_mask(clearance)
-        if within is not None:
-            mask = mask & within
-        if polygon is not None:
-            mask = mask & self._polygon_cells(polygon)
-        flat = np.flatnonzero(mask)
+        shape = self.grid.data.shape
+        flat: NDArray[np.intp] | None = None
+        if within is None and polygon is None:
+            # Fast path: draw from all free cells and filter each batch; the full candidate
+            # mask (a pass over the whole grid) is only built if that fails.
+            pool = self._free_flat()
+            wall_min = clearance + self.grid.resolution * math.sqrt(2.0)
+        else:
+            mask = self.candidate_mask(clearance)
+            if within is not None:
+                mask = mask & within
+            if polygon is not None:
+                mask = mask & self._polygon_cells(polygon)
+            pool = flat = np.flatnonzero(mask)
         chosen: list[FloatArray] = []
         tries = 0
-        while len(chosen) < n and flat.size and tries < max_tries:
+        while len(chosen) < n and pool.size and tries < max_tries:
             batch = min(256, max_tries - tries)
             tries += batch
-            cells = np.stack(np.unravel_index(rng.choice(flat, size=batch), mask.shape), axis=1)
-            pts = self._jitter(cells, rng)
+            idx = rng.choice(pool, size=batch)
+            if flat is None:
+                idx = idx[(self._wall.flat[idx] >= wall_min) & ~self._blocked().flat[idx]]
+            pts = self._jitter(np.stack(np.unravel_index(idx, shape), axis=1), rng)
             ok = self._admissible(pts, clearance, polygon)
             for p in pts[ok]:
                 if all(np.hypot(*(p - q)) >= 2 * clearance for q in chosen):
@@ -263,12 +282,19 @@ class WorldSampler:
                     if len(chosen) == n:
                         break
         if len(chosen) < n:
-            chosen = self._exhaustive(flat, mask.shape, n, chosen, clearance, polygon, rng, what)
+            if flat is None:
+                flat = np.flatnonzero(self.candidate_mask(clearance))
+            chosen = self._exhaustive(flat, shape, n, chosen, clearance, polygon, rng, what)
         out = np.array(chosen[:n], dtype=np.float64).reshape(n, 2)
         if forbid:
             for p in out:
                 self.forbid(p, clearance)
         return out
+
+    def _free_flat(self) -> NDArray[np.intp]:
+        if self._free_cache is None:
+            self._free_cache = np.flatnonzero(self.grid.free)
+        return self._free_cache
 
     def _exhaustive(
         self, flat, shape, n, chosen, clearance, polygon, rng, what: str

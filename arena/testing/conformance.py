@@ -75,6 +75,34 @@ def check_backend(make_backend, make_driver=lambda: None, steps: int = 20) -> No
             assert lim.vx_min - 1e-9 <= tw[0] <= lim.vx_max + 1e-9, "vx within limits"
             assert abs(tw[2]) <= lim.omega_max + 1e-9, "omega within limits"
         assert np.all(np.isfinite(s.robots.poses)), "finite poses"
+    _check_teleport(make_backend, make_driver, ep)
+
+
+def _check_teleport(make_backend, make_driver, ep: Episode) -> None:
+    """Teleport moves one robot at rest without advancing time; its scan sees the new place."""
+    backend = make_backend()
+    assert hasattr(type(backend), "teleport"), "does not implement SimulatorBackend.teleport"
+    backend.reset(ep, make_driver(), np.random.default_rng(7))
+    cmd = np.array([[0.5, 0.0, 0.2], [0.2, 0.0, -0.5]])
+    for _ in range(5):
+        before = backend.step(cmd, 0.1)
+    target = Pose2D(6.0, 4.0, 1.0)
+    s = backend.teleport(0, target)
+    assert s.time == before.time and s.step == before.step, "teleport must not advance time"
+    assert np.allclose(s.robots.poses[0], target.as_array()), "robot 0 is at the target pose"
+    assert np.allclose(s.robots.poses[1], before.robots.poses[1]), "other robots stay"
+    assert np.allclose(s.robots.twists[0], 0.0), "a teleported robot is at rest"
+    assert np.allclose(backend.state.robots.poses[0], target.as_array()), "state is updated"
+    spec = ep.robots[0].model.laser
+    assert s.robots.scans[0].shape == (spec.num_beams,), "one range per beam after teleport"
+    assert not np.array_equal(s.robots.scans[0], before.robots.scans[0]), (
+        "the scan is taken at the new pose"
+    )
+    # Teleporting into a wall is reported as a contact.
+    s_wall = backend.teleport(1, Pose2D(0.02, 0.02, 0.0))
+    assert bool(s_wall.collisions.wall[1]), "a robot teleported into a wall is in contact"
+    nxt = backend.step(np.zeros((2, 3)), 0.1)
+    assert np.isclose(nxt.time, s.time + 0.1), "stepping continues after a teleport"
 
 
 def _crowd_episode(grid: OccupancyGrid, starts: np.ndarray, waypoints: np.ndarray) -> AgentSpawn:

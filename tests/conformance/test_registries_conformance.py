@@ -103,6 +103,9 @@ def _scenario_file(tmp_path):
 MODE_PARAMS = {
     "robots.scenario": lambda tmp: (_scenario_file(tmp), None),
     "obstacles.scenario": lambda tmp: (_scenario_file(tmp), None),
+    "modules.benchmark": lambda tmp: ({"suite": "quick"}, None),
+    "robots.zones": lambda tmp: ({}, {"type": "world", "name": "hospital_floor"}),
+    "obstacles.zones": lambda tmp: ({}, {"type": "world", "name": "hospital_floor"}),
 }
 
 

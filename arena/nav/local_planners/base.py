@@ -50,6 +50,9 @@ class LocalObservation:
         time: simulation time (s).
         kinematics: the robot's kinematics name (one of :data:`KINEMATICS`), or ``None`` to let
             the planner infer it from ``limits`` (see :func:`infer_kinematics`).
+        goal_yaw_tolerance: heading error (rad) the navigation stack accepts at the goal, or
+            ``None`` when the goal heading does not matter. Planners that can turn the robot on
+            the spot align it to the goal's ``theta`` when this is set.
     """
 
     pose: NDArray[np.float64]
@@ -64,6 +67,7 @@ class LocalObservation:
     scan_origin: NDArray[np.float64] = field(default_factory=_zero2)
     time: float = 0.0
     kinematics: str | None = None
+    goal_yaw_tolerance: float | None = None
 
     @property
     def goal_pose(self) -> Pose2D:

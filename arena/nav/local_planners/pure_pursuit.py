@@ -45,9 +45,12 @@ Limitations:
     local planners (DWA, TEB, MPC) handle both.
 
 Goal heading:
-    Optional. With ``align_goal_heading`` a robot that can turn on the spot rotates to the goal's
-    ``theta`` once within ``goal_tolerance``; otherwise the final heading is whatever the approach
-    left (Ackermann robots never align).
+    Optional. With ``align_goal_heading``, or when the navigation stack asks for a goal heading
+    (``LocalObservation.goal_yaw_tolerance``, set from the task's ``goal_tolerance_angle``), a
+    robot that can turn on the spot rotates to the goal's ``theta`` once within
+    ``goal_tolerance`` (to within ``goal_yaw_tolerance``, or half the stack's tolerance if that
+    is smaller); otherwise the final heading is whatever the approach left. Ackermann robots
+    never align: they cannot turn on the spot, so a heading tolerance is met only by chance.
 
 Arguments:
     See :class:`PurePursuitPlanner.Params`.
@@ -298,9 +301,11 @@ class PurePursuitPlanner:
         if d_end <= p.goal_tolerance:
             self._rotating = False
             cmd = np.zeros(3)
-            if p.align_goal_heading and can_spin:
+            want = obs.goal_yaw_tolerance
+            if (p.align_goal_heading or want is not None) and can_spin:
+                tol = p.goal_yaw_tolerance if want is None else min(p.goal_yaw_tolerance, want / 2)
                 err = wrap_angle_scalar(obs.goal_pose.theta - theta)
-                if abs(err) > p.goal_yaw_tolerance:
+                if abs(err) > tol:
                     cmd[2] = p.heading_gain * err
             return limit_command(cmd, twist, lim, dt)
 

@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import SimulationError
+from arena.core.types import Pose2D
 from arena.robots.kinematics.base import KinematicState
 from arena.sensors.lidar2d import Lidar2D
 from arena.sim.backend import BACKENDS, PedestrianDriver
@@ -175,6 +176,35 @@ class Native2DBackend:
         self._step += 1
         self._take_scans()
         self._state = self._snapshot(collisions)
+        return self._state
+
+    def teleport(self, robot: int, pose: Pose2D) -> SimState:
+        """Move robot ``robot`` to ``pose`` at rest; time does not advance.
+
+        The twist, steering angle and last command of the robot become zero; contacts are
+        evaluated at the new pose (without a sweep) and the robot's lidar takes a fresh scan.
+
+        Raises:
+            SimulationError: before :meth:`reset`, for an unknown robot index or a non-finite
+                pose.
+        """
+        if self._state is None:
+            raise SimulationError("teleport() called before reset()")
+        n = len(self._names)
+        if not 0 <= robot < n:
+            raise SimulationError(f"no robot {robot}: the episode has robots 0..{n - 1}")
+        target = np.array([pose.x, pose.y, pose.theta], dtype=np.float64)
+        if not np.all(np.isfinite(target)):
+            raise SimulationError(f"teleport pose must be finite, got {target.tolist()}")
+        self._poses = self._poses.copy()
+        self._poses[robot] = target
+        self._twists[robot] = 0.0
+        self._steering[robot] = 0.0
+        self._commands[robot] = 0.0
+        # Every robot sees the moved one (multi-robot lidar), so all scans are taken afresh.
+        self._last_scan_time = [-math.inf] * n
+        self._take_scans()
+        self._state = self._snapshot(self._contacts(self._poses))
         return self._state
 
     # -- internals -----------------------------------------------------------------------------

@@ -1,3 +1,9 @@
 """Task modules (``task.modules``): hooks around each reset (curricula, maps, benchmarks, UI)."""
 
-from arena.tasks.modules import clear_forbidden_zones, dynamic_map  # noqa: F401
+from arena.tasks.modules import (  # noqa: F401
+    benchmark,
+    clear_forbidden_zones,
+    dynamic_map,
+    interactive,
+    staged,
+)

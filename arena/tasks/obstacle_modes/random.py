@@ -12,13 +12,16 @@ Interactive obstacles are placed like static ones: the 2-D backend has no pushab
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from arena.core.errors import SamplingError
 from arena.core.geometry import rectangle
+from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle, obstacle_models
 from arena.maps.raster import polygon_mask
 from arena.sim.state import Obstacle
@@ -64,50 +67,51 @@ class Count(BaseModel):
         return override if override is not None else int(rng.integers(self.min, self.max + 1))
 
 
+class PlacementParams(BaseModel):
+    """How obstacles and pedestrians are placed (shared by ``random`` and ``parametrized``)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    box_size: tuple[float, float] = Field(
+        (0.4, 1.2), description="m, [min, max] edge length of `box` obstacles"
+    )
+    obstacle_clearance: float = Field(0.6, ge=0, description="m, free gap kept around obstacles")
+    agent_radius: float = Field(0.3, gt=0, description="m (Arena's pedestrian body: 0.3-0.32)")
+    agent_speed: tuple[float, float] = Field((0.5, 1.2), description="m/s, [min, max] vmax")
+    agent_waypoints: int = Field(
+        2, ge=1, description="waypoints per pedestrian beside its start"
+    )
+    agent_leg_length: tuple[float, float] = Field(
+        (2.0, 8.0), description="m, [min, max] distance between consecutive waypoints"
+    )
+    agent_robot_clearance: float = Field(
+        1.5, ge=0, description="m, no pedestrian starts this close to a robot's start"
+    )
+    max_attempts: int = Field(200, ge=1, description="tries per placement before failing")
+
+    @model_validator(mode="after")
+    def _ranges(self) -> PlacementParams:
+        for name in ("box_size", "agent_speed", "agent_leg_length"):
+            lo, hi = getattr(self, name)
+            if not 0 < lo <= hi:
+                raise ValueError(f"{name} must be [min, max] with 0 < min <= max, got {[lo, hi]}")
+        return self
+
+
 @register_mode("obstacles", "random", tags=("default",))
 class RandomObstacles:
     """Random static and interactive obstacles and pedestrians on random round trips."""
 
-    class Params(BaseModel):
+    class Params(PlacementParams):
         """Parameters of ``obstacles.random``."""
 
-        model_config = ConfigDict(frozen=True, extra="forbid")
         static: Count = Field(default_factory=lambda: Count(min=5, max=5), description="static")
         interactive: Count = Field(default_factory=Count, description="interactive obstacles")
         dynamic: Count = Field(
             default_factory=lambda: Count(min=10, max=10, models=[]), description="pedestrians"
         )
-        box_size: tuple[float, float] = Field(
-            (0.4, 1.2), description="m, [min, max] edge length of `box` obstacles"
-        )
-        obstacle_clearance: float = Field(
-            0.6, ge=0, description="m, free gap kept around obstacles"
-        )
-        agent_radius: float = Field(0.3, gt=0, description="m (Arena's pedestrian body: 0.3-0.32)")
-        agent_speed: tuple[float, float] = Field((0.5, 1.2), description="m/s, [min, max] vmax")
-        agent_waypoints: int = Field(
-            2, ge=1, description="waypoints per pedestrian beside its start"
-        )
-        agent_leg_length: tuple[float, float] = Field(
-            (2.0, 8.0), description="m, [min, max] distance between consecutive waypoints"
-        )
-        agent_robot_clearance: float = Field(
-            1.5, ge=0, description="m, no pedestrian starts this close to a robot's start"
-        )
         elder_fraction: float = Field(
             0.2, ge=0, le=1, description="share of elder pedestrians (Arena's crowdsim: 0.2)"
         )
-        max_attempts: int = Field(200, ge=1, description="tries per placement before failing")
-
-        @model_validator(mode="after")
-        def _ranges(self) -> RandomObstacles.Params:
-            for name in ("box_size", "agent_speed", "agent_leg_length"):
-                lo, hi = getattr(self, name)
-                if not 0 < lo <= hi:
-                    raise ValueError(
-                        f"{name} must be [min, max] with 0 < min <= max, got {[lo, hi]}"
-                    )
-            return self
 
     def __init__(self, params: Params | None = None) -> None:
         self.params = params or self.Params()
@@ -122,113 +126,168 @@ class RandomObstacles:
             ("I", p.interactive, ctx.counts.interactive),
         ):
             n = count.draw(rng, override)
-            placed += self._place(ctx, prefix, n, count.models, rng)
+            placed += place_obstacles(ctx, prefix, n, count.models, rng, p)
         n_agents = p.dynamic.draw(rng, ctx.counts.dynamic)
-        return placed, self._agents(ctx, n_agents, placed, ctx.rng("pedestrians"))
-
-    # -- static ------------------------------------------------------------------------------
-    def _place(
-        self, ctx: ResetContext, prefix: str, n: int, models: list[str], rng: np.random.Generator
-    ) -> list[Obstacle]:
-        p = self.params
-        out: list[Obstacle] = []
-        per_model: dict[str, int] = {}
-        for k in range(n):
-            model = models[int(rng.integers(len(models)))] if models else BOX
-            ob = None
-            # A box that does not fit is redrawn with another size; a library model cannot be.
-            for _ in range(p.max_attempts if model == BOX else 1):
-                if model == BOX:
-                    footprint = rectangle(*rng.uniform(*p.box_size, size=2))
-                else:
-                    footprint = obstacle_models()[model].polygon()
-                radius = float(np.linalg.norm(footprint, axis=1).max())
-                try:
-                    xy = ctx.sampler.sample(
-                        1, radius + p.obstacle_clearance, rng, what="", forbid=False
-                    )[0]
-                except SamplingError:
-                    continue
-                per_model[model] = per_model.get(model, 0) + 1
-                name = f"{prefix}_{model}_{per_model[model]}"
-                pose = [xy[0], xy[1], float(rng.uniform(-np.pi, np.pi))]
-                if model == BOX:
-                    ob = Obstacle(name, "cuboid", np.array(pose), footprint,
-                                  height=float(rng.uniform(0.5, 1.5)))
-                else:
-                    ob = make_obstacle(name, model, pose)
-                break
-            if ob is None:
-                raise SamplingError(
-                    f"could not place obstacle {k + 1} of {n} ({prefix}_{model}) on map "
-                    f"{ctx.map.name!r} with a free gap of {p.obstacle_clearance} m around it; "
-                    "lower the obstacle counts or task.obstacles.obstacle_clearance"
-                )
-            ctx.sampler.add_obstacles([ob])
-            out.append(ob)
-        return out
-
-    # -- pedestrians ---------------------------------------------------------------------------
-    def _agents(
-        self, ctx: ResetContext, n: int, placed: list[Obstacle], rng: np.random.Generator
-    ) -> AgentSpawn:
-        p = self.params
-        if n == 0:
-            return AgentSpawn.empty()
-        grid = ctx.map.grid
-        body = p.agent_radius + 0.05
-        world = ctx.sampler
-        # Starts keep agent_robot_clearance from every robot start (beyond the robot's body).
-        for r in ctx.spawns:
-            world.forbid(r.start.xy, r.model.radius + p.agent_robot_clearance)
-        starts = world.sample(n, body, rng, what=f"{n} pedestrians")
-        obstacles = list(ctx.map.obstacles) + placed
-        blocked = grid.occupied | ~grid.free
-        if obstacles:
-            blocked = blocked | polygon_mask(grid, [o.polygon for o in obstacles])
-        walkable = (clearance_map(grid, blocked) > body) & grid.free
-        labels = components(walkable)
-        cells = np.argwhere(walkable)
-        cell_labels = labels[cells[:, 0], cells[:, 1]]
-        k = p.agent_waypoints
-        # Round trip start → w1 → … → wk → … → w1 → start, so a loop never crosses a wall.
-        n_wp = 2 * k
-        waypoints = np.full((n, n_wp, 2), np.nan)
-        order = np.argsort(cell_labels, kind="stable")
-        bounds = np.searchsorted(cell_labels[order], np.arange(cell_labels.max(initial=0) + 2))
-        for i in range(n):
-            chain = [starts[i]]
-            r, c = grid.world_to_cell(starts[i])
-            lab = labels[r, c]
-            region_cells = cells[order[bounds[lab] : bounds[lab + 1]]] if lab else cells[:0]
-            for _ in range(k):
-                chain.append(self._next_waypoint(grid, walkable, region_cells, chain[-1], rng))
-            trip = chain[1:] + chain[-2::-1]
-            waypoints[i, : len(trip)] = trip
-        return AgentSpawn(
-            positions=starts,
-            radii=np.full(n, p.agent_radius),
-            vmax=rng.uniform(*p.agent_speed, size=n),
-            waypoints=waypoints,
-            num_waypoints=np.full(n, n_wp, dtype=np.int64),
-            waypoint_mode=np.full(n, WAYPOINT_LOOP, dtype=np.int64),
-            kinds=(rng.random(n) < p.elder_fraction).astype(np.int64),
+        return placed, place_pedestrians(
+            ctx, n_agents, placed, ctx.rng("pedestrians"), p, elder_fraction=p.elder_fraction
         )
 
-    def _next_waypoint(self, grid, walkable, region_cells, prev, rng) -> np.ndarray:
-        """A point of the region ``agent_leg_length`` away from ``prev`` and visible from it."""
-        p = self.params
-        lo, hi = p.agent_leg_length
-        if len(region_cells) == 0:
-            return np.array(prev, dtype=np.float64)
-        for near_ok in (False, True):  # second pass: any visible cell ≥ 0.5 m away
-            for _ in range(p.max_attempts // 20 + 1):
-                batch = region_cells[rng.integers(len(region_cells), size=64)]
-                pts = jitter(grid, batch, rng)
-                d = np.hypot(*(pts - prev).T)
-                ok = (d >= min(lo, 0.5)) if near_ok else (d >= lo) & (d <= hi)
-                for xy in pts[ok]:
-                    if line_of_sight(grid, walkable, prev, xy):
-                        return xy
-        # No visible waypoint (a tiny enclosed pocket): stay put rather than cross a wall.
+
+# -- static ----------------------------------------------------------------------------------
+def place_obstacles(
+    ctx: ResetContext,
+    prefix: str,
+    n: int,
+    models: Sequence[str],
+    rng: np.random.Generator,
+    params: PlacementParams,
+    *,
+    counter: dict[str, int] | None = None,
+) -> list[Obstacle]:
+    """Place ``n`` obstacles drawn uniformly from ``models`` and add them to ``ctx.sampler``.
+
+    Each keeps ``params.obstacle_clearance`` (m) beyond its circumscribed radius from walls,
+    obstacles and forbidden zones. Names are ``<prefix>_<model>_<k>`` (``k`` from 1 per model);
+    ``counter`` (``"<prefix>_<model>"`` → last ``k``) continues the numbering across calls.
+
+    Raises:
+        SamplingError: if an obstacle finds no room.
+    """
+    p = params
+    out: list[Obstacle] = []
+    per_model: dict[str, int] = {} if counter is None else counter
+    for k in range(n):
+        model = models[int(rng.integers(len(models)))] if models else BOX
+        ob = None
+        # A box that does not fit is redrawn with another size; a library model cannot be.
+        for _ in range(p.max_attempts if model == BOX else 1):
+            if model == BOX:
+                footprint = rectangle(*rng.uniform(*p.box_size, size=2))
+            else:
+                footprint = obstacle_models()[model].polygon()
+            radius = float(np.linalg.norm(footprint, axis=1).max())
+            try:
+                xy = ctx.sampler.sample(
+                    1, radius + p.obstacle_clearance, rng, what="", forbid=False
+                )[0]
+            except SamplingError:
+                continue
+            key = f"{prefix}_{model}"
+            per_model[key] = per_model.get(key, 0) + 1
+            name = f"{key}_{per_model[key]}"
+            pose = [xy[0], xy[1], float(rng.uniform(-np.pi, np.pi))]
+            if model == BOX:
+                ob = Obstacle(name, "cuboid", np.array(pose), footprint,
+                              height=float(rng.uniform(0.5, 1.5)))
+            else:
+                ob = make_obstacle(name, model, pose)
+            break
+        if ob is None:
+            raise SamplingError(
+                f"could not place obstacle {k + 1} of {n} ({prefix}_{model}) on map "
+                f"{ctx.map.name!r} with a free gap of {p.obstacle_clearance} m around it; "
+                "lower the obstacle counts or task.obstacles.obstacle_clearance"
+            )
+        ctx.sampler.add_obstacles([ob])
+        out.append(ob)
+    return out
+
+
+# -- pedestrians -------------------------------------------------------------------------------
+def place_pedestrians(
+    ctx: ResetContext,
+    n: int,
+    placed: Sequence[Obstacle],
+    rng: np.random.Generator,
+    params: PlacementParams,
+    *,
+    kinds: NDArray[np.int64] | None = None,
+    elder_fraction: float = 0.0,
+) -> AgentSpawn:
+    """``n`` pedestrians on round trips between mutually visible waypoints.
+
+    Starts keep ``params.agent_robot_clearance`` (m) beyond every robot's body from the robots'
+    starts; every leg is ``params.agent_leg_length`` long and in line of sight.
+
+    Args:
+        ctx: the episode (its map, sampler and robot spawns).
+        n: number of pedestrians.
+        placed: obstacles of this episode beside the map's own.
+        rng: the pedestrians' random stream.
+        params: radius, speeds, waypoints and clearances.
+        kinds: ``(n,)`` type codes (0 adult, 1 elder, 2 child); ``None`` draws elders with
+            probability ``elder_fraction`` (after all other draws).
+        elder_fraction: share of elders when ``kinds`` is ``None``.
+    """
+    p = params
+    if n == 0:
+        return AgentSpawn.empty()
+    if kinds is not None and kinds.shape != (n,):
+        raise ValueError(f"kinds must have shape ({n},), got {kinds.shape}")
+    grid = ctx.map.grid
+    body = p.agent_radius + 0.05
+    world = ctx.sampler
+    # Starts keep agent_robot_clearance from every robot start (beyond the robot's body).
+    for r in ctx.spawns:
+        world.forbid(r.start.xy, r.model.radius + p.agent_robot_clearance)
+    starts = world.sample(n, body, rng, what=f"{n} pedestrians")
+    obstacles = list(ctx.map.obstacles) + list(placed)
+    blocked = grid.occupied | ~grid.free
+    if obstacles:
+        blocked = blocked | polygon_mask(grid, [o.polygon for o in obstacles])
+    walkable = (clearance_map(grid, blocked) > body) & grid.free
+    labels = components(walkable)
+    cells = np.argwhere(walkable)
+    cell_labels = labels[cells[:, 0], cells[:, 1]]
+    k = p.agent_waypoints
+    # Round trip start → w1 → … → wk → … → w1 → start, so a loop never crosses a wall.
+    n_wp = 2 * k
+    waypoints = np.full((n, n_wp, 2), np.nan)
+    order = np.argsort(cell_labels, kind="stable")
+    bounds = np.searchsorted(cell_labels[order], np.arange(cell_labels.max(initial=0) + 2))
+    for i in range(n):
+        chain = [starts[i]]
+        r, c = grid.world_to_cell(starts[i])
+        lab = labels[r, c]
+        region_cells = cells[order[bounds[lab] : bounds[lab + 1]]] if lab else cells[:0]
+        for _ in range(k):
+            chain.append(_next_waypoint(grid, walkable, region_cells, chain[-1], rng, p))
+        trip = chain[1:] + chain[-2::-1]
+        waypoints[i, : len(trip)] = trip
+    vmax = rng.uniform(*p.agent_speed, size=n)
+    if kinds is None:
+        kinds = (rng.random(n) < elder_fraction).astype(np.int64)
+    return AgentSpawn(
+        positions=starts,
+        radii=np.full(n, p.agent_radius),
+        vmax=vmax,
+        waypoints=waypoints,
+        num_waypoints=np.full(n, n_wp, dtype=np.int64),
+        waypoint_mode=np.full(n, WAYPOINT_LOOP, dtype=np.int64),
+        kinds=np.asarray(kinds, dtype=np.int64),
+    )
+
+
+def _next_waypoint(
+    grid: OccupancyGrid,
+    walkable: NDArray[np.bool_],
+    region_cells: NDArray[np.int64],
+    prev: NDArray[np.float64],
+    rng: np.random.Generator,
+    p: PlacementParams,
+) -> NDArray[np.float64]:
+    """A point of the region ``agent_leg_length`` away from ``prev`` and visible from it."""
+    lo, hi = p.agent_leg_length
+    if len(region_cells) == 0:
         return np.array(prev, dtype=np.float64)
+    for near_ok in (False, True):  # second pass: any visible cell ≥ 0.5 m away
+        for _ in range(p.max_attempts // 20 + 1):
+            batch = region_cells[rng.integers(len(region_cells), size=64)]
+            pts = jitter(grid, batch, rng)
+            d = np.hypot(*(pts - prev).T)
+            ok = (d >= min(lo, 0.5)) if near_ok else (d >= lo) & (d <= hi)
+            for xy in pts[ok]:
+                if line_of_sight(grid, walkable, prev, xy):
+                    return np.asarray(xy, dtype=np.float64)
+    # No visible waypoint (a tiny enclosed pocket): stay put rather than cross a wall.
+    return np.array(prev, dtype=np.float64)

@@ -1,0 +1,68 @@
+"""Task data files shipped in ``arena/tasks/data/``: curricula, benchmark suites and contests.
+
+A file is named either by a packaged name (``"default"`` → ``data/curricula/default.yaml``) or
+by a path. :func:`read_yaml_any` reads any YAML document (curricula are lists) and reports
+malformed YAML with the file, line and column.
+"""
+
+from __future__ import annotations
+
+import difflib
+from pathlib import Path
+from typing import Any, Literal
+
+import yaml
+
+from arena.core.errors import ConfigError
+
+DATA_DIR = Path(__file__).resolve().parent / "data"
+"""Folder of the packaged task data files."""
+
+Kind = Literal["curricula", "suites", "contests"]
+
+
+def packaged(kind: Kind) -> list[str]:
+    """Names of the packaged files of one kind (without ``.yaml``)."""
+    folder = DATA_DIR / kind
+    return sorted(p.stem for p in folder.glob("*.yaml")) if folder.is_dir() else []
+
+
+def find_data_file(kind: Kind, name_or_path: str | Path) -> Path:
+    """The file a packaged name or a path names.
+
+    Raises:
+        ConfigError: neither an existing file nor a packaged name (with a close match).
+    """
+    p = Path(name_or_path).expanduser()
+    if p.is_file():
+        return p
+    text = str(name_or_path)
+    stem = text[:-5] if text.endswith(".yaml") else text
+    candidate = DATA_DIR / kind / f"{stem}.yaml"
+    if "/" not in stem and candidate.is_file():
+        return candidate
+    known = packaged(kind)
+    close = difflib.get_close_matches(stem, known, n=1, cutoff=0.5)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise ConfigError(
+        f"no {kind[:-1] if kind != 'curricula' else 'curriculum'} {text!r}: not a file and not "
+        f"a packaged name; {hint}packaged: {', '.join(known) or '(none)'}"
+    )
+
+
+def read_yaml_any(path: str | Path) -> Any:
+    """Parse a YAML file of any shape; malformed YAML names the file, line and column."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise ConfigError("file not found", source=str(p)) from None
+    except (OSError, UnicodeDecodeError) as e:
+        raise ConfigError(f"cannot read file: {e}", source=str(p)) from None
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
+        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
+        raise ConfigError(f"malformed YAML{where}: {problem}", source=str(p)) from None

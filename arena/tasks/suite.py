@@ -1,0 +1,492 @@
+"""Benchmark suites and contests (Arena specs §2.9), loaded unchanged from Arena's files.
+
+``arena_bringup/configs/benchmark/``:
+
+* ``suites/<name>.yaml``: ``stages: [{name, episodes, robot, map, tm_robots, tm_obstacles,
+  config: {<task_generator.yaml overlay>}, seed?, timeout?}]``.
+* ``contests/<name>.yaml``: ``contestants: [{name, local_planner, inter_planner: bypass}]``.
+* ``config.yaml``: ``suite: {config, scale_episodes: 1}``, ``contest: {config}``,
+  ``general: {simulator}``.
+
+Arena's ``config`` overlay maps onto our ``task`` block: ``RANDOM.{static,interactive}.{min,max,
+models}`` → ``obstacles.random`` counts and models, ``RANDOM.dynamic.{min,max}`` → pedestrian
+counts, ``SCENARIO.file`` → the scenario file (relative to the stage world's ``scenarios/``
+folder, Arena's ``worlds/<map>/scenarios/``), ``timeout`` and ``goal_radius`` → the same keys.
+``RANDOM.dynamic.models`` names Arena's pedestrian actor models (``actor1``): our pedestrians
+are simulated bodies with no mesh, so the names are accepted and ignored. ``RANDOM.seed``
+replaces the stage seed (Arena applies the stage's ``config`` after the stage seed).
+
+Our native additions per stage: ``map`` may be a packaged world name, a world folder (relative
+to the suite file), Arena's ``dynamic_map`` (the run's generated map) or a map block
+(``{type: canteen, ...}``); ``task:`` is an overlay in our :class:`~arena.tasks.config.TaskConfig`
+format merged last; ``map_per_episode`` (default true) gives a generated map a new instance
+every episode.
+
+A stage's seed defaults to Arena's: the last 4 bytes of the SHA-1 of the stage's canonical JSON
+(sorted keys), as a non-negative int32. The episodes of a stage are drawn from
+:func:`stage_run_seed` of the run seed and the stage seed, with episode numbers local to the
+stage, so episode k of a stage is the same whatever comes before it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from arena.config.loader import merge
+from arena.config.schema import ExperimentConfig
+from arena.core.errors import ConfigError, from_validation_error
+from arena.core.rng import child_seed
+from arena.maps.sources import MAP_SOURCES, resolve_world
+from arena.tasks.datafiles import find_data_file, read_yaml_any
+
+
+class _Arena(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class RandomClass(_Arena):
+    """Arena's ``RANDOM.<class>``: count range and model names."""
+
+    min: int | None = Field(None, ge=0, description="fewest of this class")
+    max: int | None = Field(None, ge=0, description="most of this class")
+    models: list[str] | None = Field(None, description="model names (Arena: list or 'a;b')")
+
+    @field_validator("models", mode="before")
+    @classmethod
+    def _split(cls, v: Any) -> Any:
+        if isinstance(v, str):  # dynamic_reconfigure's ";"-separated string
+            return [s.strip() for s in v.split(";") if s.strip()]
+        return v
+
+
+class RandomBlock(_Arena):
+    """Arena's ``RANDOM`` block."""
+
+    seed: int | None = Field(None, description="replaces the stage seed when >= 0 (-1: unset)")
+    static: RandomClass | None = None
+    interactive: RandomClass | None = None
+    dynamic: RandomClass | None = None
+
+
+class FileBlock(_Arena):
+    """Arena's ``SCENARIO`` / ``PARAMETRIZED`` block."""
+
+    file: str = Field(description="file name")
+
+
+class StagedBlock(_Arena):
+    """Arena's ``STAGED`` block."""
+
+    curriculum: str = "default"
+    index: int = Field(0, ge=0)
+
+
+class ZonesBlock(_Arena):
+    """Arena's ``ZONES`` block."""
+
+    file: str | None = None
+    scenario: str | None = None
+
+
+class TaskOverlay(_Arena):
+    """A stage's ``config``: a partial Arena ``task_generator.yaml``."""
+
+    RANDOM: RandomBlock | None = None
+    SCENARIO: FileBlock | None = None
+    PARAMETRIZED: FileBlock | None = None
+    STAGED: StagedBlock | None = None
+    ZONES: ZonesBlock | None = None
+    timeout: float | None = Field(None, description="s per episode")
+    goal_radius: float | None = Field(None, gt=0, description="m")
+    goal_tolerance_angle: float | None = Field(None, gt=0, description="rad")
+    episodes: int | None = Field(None, description="Arena's desired resets; the stage decides")
+
+
+class SuiteStage(_Arena):
+    """One stage of a suite."""
+
+    name: str = Field(description="stage name (reports, output folders)")
+    episodes: int = Field(ge=0, description="episodes before scale_episodes")
+    robot: str | None = Field(None, description="robot preset or YAML; None: the run's")
+    map: str | dict[str, Any] | None = Field(
+        None, description="world name/folder, 'dynamic_map' or a map block; None: the run's"
+    )
+    tm_robots: str = Field("random", description="robot task mode")
+    tm_obstacles: str = Field("random", description="obstacle task mode")
+    config: TaskOverlay = Field(default_factory=TaskOverlay, description="Arena overlay")
+    task: dict[str, Any] | None = Field(None, description="overlay in our task format")
+    seed: int | None = Field(None, ge=0, description="stage seed; default from SHA-1")
+    timeout: float | None = Field(None, gt=0, description="s per episode; default: the run's")
+    map_per_episode: bool = Field(
+        True, description="a generated map gets a new instance every episode"
+    )
+
+
+class SuiteFile(_Arena):
+    """``suites/<name>.yaml``."""
+
+    stages: list[SuiteStage] = Field(min_length=1)
+
+
+class Contestant(_Arena):
+    """One contestant: a navigation stack."""
+
+    name: str
+    local_planner: str = Field(description="local planner name")
+    inter_planner: str = Field("bypass", description="Arena's intermediate planner")
+
+
+class ContestFile(_Arena):
+    """``contests/<name>.yaml``."""
+
+    contestants: list[Contestant] = Field(min_length=1)
+
+
+class SuiteRef(_Arena):
+    """``config.yaml`` ``suite`` block."""
+
+    config: str
+    scale_episodes: float = Field(1.0, gt=0)
+
+
+class ContestRef(_Arena):
+    """``config.yaml`` ``contest`` block."""
+
+    config: str
+
+
+class GeneralBlock(_Arena):
+    """``config.yaml`` ``general`` block."""
+
+    simulator: Literal["flatland", "gazebo", "unity", "native2d"] | str = "flatland"
+
+
+class BenchmarkFile(_Arena):
+    """Arena's benchmark ``config.yaml``."""
+
+    suite: SuiteRef
+    contest: ContestRef | None = None
+    general: GeneralBlock = Field(default_factory=GeneralBlock)
+
+
+def _validate(model: type[BaseModel], data: Any, source: str) -> Any:
+    try:
+        return model.model_validate(data)
+    except ValidationError as e:
+        raise from_validation_error(e, source=source) from None
+
+
+def arena_stage_seed(raw: dict[str, Any]) -> int:
+    """Arena's default stage seed: last 4 bytes of SHA-1 of the stage's JSON, as int32 >= 0."""
+    digest = hashlib.sha1(json.dumps(raw, sort_keys=True, default=str).encode()).digest()
+    return int.from_bytes(digest[-4:], "big") & 0x7FFFFFFF
+
+
+def stage_run_seed(run_seed: int, stage_seed: int) -> int:
+    """The seed a stage's episodes are drawn from, given the run's master seed."""
+    return child_seed(int(run_seed), "benchmark", int(stage_seed))
+
+
+class Suite:
+    """A loaded suite: stages with their seeds, episode counts and source file.
+
+    Attributes:
+        stages: the stages in order.
+        seeds: per stage, the stage seed (explicit, ``RANDOM.seed`` or Arena's SHA-1 default).
+        source: the suite file.
+        scale_episodes: factor on every stage's episode count (Arena: ``int(episodes × s)``).
+    """
+
+    def __init__(
+        self, file: SuiteFile, raw: list[dict[str, Any]], source: str, scale_episodes: float = 1.0
+    ) -> None:
+        if scale_episodes <= 0:
+            raise ConfigError(f"scale_episodes must be > 0, got {scale_episodes}", source=source)
+        self.stages = list(file.stages)
+        self.source = source
+        self.scale_episodes = float(scale_episodes)
+        self.seeds = []
+        for st, r in zip(self.stages, raw, strict=True):
+            seed = st.seed if st.seed is not None else arena_stage_seed(r)
+            rnd = st.config.RANDOM
+            if rnd is not None and rnd.seed is not None and rnd.seed >= 0:
+                seed = rnd.seed
+            self.seeds.append(seed)
+
+    @property
+    def episode_counts(self) -> list[int]:
+        """Episodes per stage after ``scale_episodes``."""
+        return [int(st.episodes * self.scale_episodes) for st in self.stages]
+
+    @property
+    def total_episodes(self) -> int:
+        """Episodes of the whole suite."""
+        return sum(self.episode_counts)
+
+    def locate(self, index: int) -> tuple[int, int]:
+        """``(stage, local index)`` of the suite's episode ``index``."""
+        if index < 0:
+            raise IndexError(f"episode index must be >= 0, got {index}")
+        rest = index
+        for s, n in enumerate(self.episode_counts):
+            if rest < n:
+                return s, rest
+            rest -= n
+        raise IndexError(f"episode {index} is past the suite's {self.total_episodes} episodes")
+
+    # -- stage → experiment ------------------------------------------------------------------
+    def stage_map(self, i: int, base_map: dict[str, Any]) -> dict[str, Any]:
+        """Stage ``i``'s map block (``base_map`` where the stage names none)."""
+        st = self.stages[i]
+        where = f"stages[{i}].map"
+        m = st.map
+        if m is None:
+            return dict(base_map)
+        if isinstance(m, dict):
+            try:
+                MAP_SOURCES.validate(m, source=self.source, path=where)
+            except ConfigError as e:
+                raise ConfigError(e.message, source=self.source, path=e.path or where) from None
+            return dict(m)
+        if m == "dynamic_map":  # Arena's map_file for generated maps
+            if "generator" in MAP_SOURCES.entry(str(base_map.get("type"))).tags:
+                return dict(base_map)
+            return {"type": "rosnav_indoor"}
+        base = Path(self.source).resolve().parent
+        for folder in (base / m, base / "worlds" / m, base.parent / "worlds" / m):
+            if (folder / "map" / "map.yaml").is_file() or (folder / "map.yaml").is_file():
+                return {"type": "world", "name": str(folder)}
+        try:
+            resolve_world(m)
+        except ConfigError as e:
+            raise ConfigError(e.message, source=self.source, path=where) from None
+        return {"type": "world", "name": m}
+
+    def _world_folder(self, map_block: dict[str, Any]) -> Path | None:
+        if map_block.get("type") != "world":
+            return None
+        return resolve_world(str(map_block["name"])).parent.parent
+
+    def _scenario_file(self, i: int, map_block: dict[str, Any]) -> str:
+        st = self.stages[i]
+        name = st.config.SCENARIO.file if st.config.SCENARIO else "default.json"
+        where = f"stages[{i}].config.SCENARIO.file"
+        p = Path(name).expanduser()
+        candidates = [p] if p.is_absolute() else []
+        folder = self._world_folder(map_block)
+        if folder is not None and not p.is_absolute():
+            candidates.append(folder / "scenarios" / p)
+        if not p.is_absolute():
+            candidates.append(Path(self.source).resolve().parent / p)
+        for c in candidates:
+            if c.is_file():
+                return str(c)
+        looked = ", ".join(str(c) for c in candidates) or name
+        raise ConfigError(f"scenario file {name!r} not found (looked at {looked})",
+                          source=self.source, path=where)
+
+    def stage_task(self, i: int, base_task: dict[str, Any], map_block: dict[str, Any]) -> dict:
+        """Stage ``i``'s ``task`` block: base, then Arena's overlay, then the ``task:`` overlay."""
+        st = self.stages[i]
+        cfg = st.config
+        task = {k: v for k, v in base_task.items() if k not in ("robots", "obstacles")}
+        task["modules"] = []
+        scenario = None
+        if "scenario" in (st.tm_robots, st.tm_obstacles):
+            scenario = self._scenario_file(i, map_block)
+        robots: dict[str, Any] = {"type": st.tm_robots}
+        if st.tm_robots == "scenario":
+            robots["file"] = scenario
+        elif base_task.get("robots", {}).get("type") == st.tm_robots:
+            robots = dict(base_task["robots"])
+        obstacles: dict[str, Any] = {"type": st.tm_obstacles}
+        if st.tm_obstacles == "scenario":
+            obstacles["file"] = scenario
+        elif st.tm_obstacles == "random":
+            if base_task.get("obstacles", {}).get("type") == "random":
+                obstacles = json.loads(json.dumps(base_task["obstacles"]))
+            rnd = cfg.RANDOM
+            for cls in ("static", "interactive", "dynamic"):
+                c = getattr(rnd, cls) if rnd is not None else None
+                if c is None:
+                    continue
+                old = obstacles.get(cls, {})
+                block: dict[str, Any] = dict(old) if isinstance(old, dict) else {}
+                if isinstance(old, int) and not isinstance(old, bool):
+                    block = {"min": old, "max": old}
+                elif isinstance(old, list):
+                    block = {"min": old[0], "max": old[1]}
+                if c.min is not None:
+                    block["min"] = c.min
+                if c.max is not None:
+                    block["max"] = c.max
+                if c.min is not None and c.max is None:
+                    block["max"] = max(c.min, int(block.get("max", c.min)))
+                # Pedestrian models (actor1 ...) are Arena meshes: ignored (see module docs).
+                if c.models is not None and cls != "dynamic":
+                    block["models"] = list(c.models)
+                obstacles[cls] = block
+        task["robots"] = robots
+        task["obstacles"] = obstacles
+        if cfg.timeout is not None:
+            task["timeout"] = cfg.timeout if cfg.timeout > 0 else 1e9
+        if st.timeout is not None:
+            task["timeout"] = st.timeout
+        for key in ("goal_radius", "goal_tolerance_angle"):
+            if getattr(cfg, key) is not None:
+                task[key] = getattr(cfg, key)
+        if st.task is not None:
+            task = merge(task, st.task)
+        return task
+
+    def stage_experiments(
+        self, base_cfg: ExperimentConfig
+    ) -> list[tuple[SuiteStage, ExperimentConfig]]:
+        """One experiment per stage, run on its own equal to the stage inside the suite.
+
+        The experiment's seed is :func:`stage_run_seed` of ``base_cfg.seed`` and the stage
+        seed; a generated map that changes per episode gets ``dynamic_map`` (one map per
+        episode). Stages scaled to 0 episodes are left out.
+
+        Raises:
+            ConfigError: a missing world or scenario, an unknown mode or model, naming the
+                suite file and the stage's key path (``stages[3].map``).
+        """
+        from arena.config.loader import validate_plugins
+
+        base = base_cfg.model_dump(mode="json")
+        out = []
+        for i, (st, n) in enumerate(zip(self.stages, self.episode_counts, strict=True)):
+            if n == 0:
+                continue
+            map_block = self.stage_map(i, base["map"])
+            try:
+                task = self.stage_task(i, base["task"], map_block)
+            except ConfigError as e:
+                if e.source is None:
+                    raise e.located(source=self.source, prefix=f"stages[{i}]") from None
+                raise
+            if self.is_generated(map_block) and st.map_per_episode:
+                task["modules"] = [{"type": "dynamic_map", "episodes_per_map": 1},
+                                   *task.get("modules", [])]
+            data = {
+                **base,
+                "name": f"{base_cfg.name}/{st.name}",
+                "seed": stage_run_seed(base_cfg.seed, self.seeds[i]),
+                "episodes": n,
+                "robot": st.robot or base["robot"],
+                "map": map_block,
+                "task": task,
+            }
+            try:
+                cfg = ExperimentConfig.model_validate(data)
+            except ValidationError as e:
+                err = from_validation_error(e, source=self.source)
+                raise _stage_error(err, i, self.source) from None
+            try:
+                validate_plugins(cfg, source=self.source)
+            except ConfigError as e:
+                raise _stage_error(e, i, self.source) from None
+            out.append((st, cfg))
+        return out
+
+    @staticmethod
+    def is_generated(map_block: dict[str, Any]) -> bool:
+        """Whether a map block names a procedural generator (a new map per seed/key)."""
+        try:
+            return "generator" in MAP_SOURCES.entry(str(map_block.get("type"))).tags
+        except ConfigError:
+            return False
+
+
+_STAGE_KEYS = {
+    "robot": "robot",
+    "map": "map",
+    "task.robots": "tm_robots",
+    "task.obstacles": "config.RANDOM",
+    "task": "task",
+}
+
+
+def _stage_error(err: ConfigError, i: int, source: str) -> ConfigError:
+    """Name the stage key a problem in the derived experiment comes from."""
+    path = err.path or ""
+    where = f"stages[{i}]"
+    for prefix, key in _STAGE_KEYS.items():
+        if path == prefix or path.startswith(prefix + ".") or path.startswith(prefix + "["):
+            where = f"stages[{i}].{key}"
+            break
+    detail = f" ({path})" if path else ""
+    return ConfigError(err.message + detail, source=source, path=where)
+
+
+def load_suite(name_or_path: str | Path, *, scale_episodes: float = 1.0) -> Suite:
+    """Load a packaged suite (``"paper"``, ``"quick"``) or a suite file.
+
+    Only the file's structure is checked here; worlds and scenarios are resolved by
+    :meth:`Suite.stage_experiments`.
+    """
+    path = find_data_file("suites", name_or_path)
+    source = str(path)
+    data = read_yaml_any(path)
+    if not isinstance(data, dict):
+        raise ConfigError(
+            f"expected a mapping {{stages: [...]}}, got {type(data).__name__}", source=source
+        )
+    file = _validate(SuiteFile, data, source)
+    return Suite(file, list(data["stages"]), source, scale_episodes)
+
+
+def load_contest(name_or_path: str | Path) -> tuple[ContestFile, str]:
+    """Load a packaged contest (``"basic"``) or a contest file; returns it and its path."""
+    path = find_data_file("contests", name_or_path)
+    data = read_yaml_any(path)
+    return _validate(ContestFile, data, str(path)), str(path)
+
+
+def contestant_config(
+    base_cfg: ExperimentConfig, contestant: Contestant, *, source: str | None = None, index: int = 0
+) -> ExperimentConfig:
+    """``base_cfg`` driven by the contestant's local planner.
+
+    ``inter_planner`` is Arena's intermediate planner; ``bypass`` passes the global path
+    through, which is what our stack does, so it needs no setting here.
+    """
+    from arena.nav.local_planners.base import LOCAL_PLANNERS
+
+    where = f"contestants[{index}].local_planner"
+    try:
+        LOCAL_PLANNERS.entry(contestant.local_planner)
+    except ConfigError as e:
+        raise ConfigError(e.message, source=source, path=where) from None
+    data = base_cfg.model_dump(mode="json")
+    nav = data["navigation"]
+    nav["local_planner"] = {"type": contestant.local_planner}
+    return ExperimentConfig.model_validate({**data, "name": contestant.name})
+
+
+def load_benchmark(path: str | Path) -> tuple[Suite, tuple[ContestFile, str] | None]:
+    """Arena's benchmark ``config.yaml``: the suite (scaled) and the contest, if any.
+
+    ``suite.config`` / ``contest.config`` are looked up in the ``suites/`` / ``contests/``
+    folders next to the file (Arena's layout), then as paths and packaged names.
+    """
+    p = Path(path)
+    data = read_yaml_any(p)
+    bench = _validate(BenchmarkFile, data, str(p))
+
+    def find(folder: str, name: str) -> str:
+        for c in (p.parent / folder / name, p.parent / folder / f"{name}.yaml"):
+            if c.is_file():
+                return str(c)
+        return name
+
+    suite = load_suite(find("suites", bench.suite.config),
+                       scale_episodes=bench.suite.scale_episodes)
+    contest = load_contest(find("contests", bench.contest.config)) if bench.contest else None
+    return suite, contest
