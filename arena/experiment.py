@@ -56,6 +56,7 @@ class EpisodeResult:
     seed: int
     map: str
     robot: str
+    stage: str
     outcome: str
     time: float
     steps: int
@@ -312,9 +313,10 @@ def run_episode(
     final = poses[-1]
     result = EpisodeResult(
         index=idx,
-        seed=seed,
+        seed=episode.seed,
         map=episode.map_name,
         robot=robot.name,
+        stage=episode.label,
         outcome=outcome.value,
         time=round(state.time, 6),
         steps=state.step,
@@ -333,7 +335,7 @@ def run_episode(
         result.files.update(recorder.write(out_dir))
         if video and states:
             result.files.update(
-                _write_video(cfg, backend, states, stack.path, goal, out_dir, outcome)
+                _write_video(cfg, backend, states, stack.path, goal, out_dir, outcome, episode)
             )
         result.wall_time = time.perf_counter() - t0
         (out_dir / "episode.json").write_text(json.dumps(asdict(result), indent=2))
@@ -342,17 +344,19 @@ def run_episode(
 
 
 def _write_video(
-    cfg, backend, states, path, goal, out_dir: Path, outcome: Outcome
+    cfg, backend, states, path, goal, out_dir: Path, outcome: Outcome, episode: Episode
 ) -> dict[str, str]:
     # Imported here: rendering is optional and the only user of matplotlib.
     from arena.render import FrameRenderer, Overlay, VideoWriter, save_png
 
-    robot_specs = [load_robot(cfg.robot).laser]
+    robot_specs = [spawn.model.laser for spawn in episode.robots]
     renderer = FrameRenderer(
         backend.world,
         lidar_specs=robot_specs,
         width_px=cfg.output.width_px,
-        title=f"{cfg.name} · {states[0].robots.models[0]} · {cfg.crowd['type']}",
+        title=" · ".join(
+            t for t in (cfg.name, episode.label, states[0].robots.models[0], cfg.crowd["type"]) if t
+        ),
         legend=len(states[0].agents) > 0,
     )
     video_path = out_dir / f"video.{cfg.output.video_format}"
@@ -437,6 +441,7 @@ def _write_summary(path: Path, results: list[EpisodeResult]) -> None:
         "seed",
         "map",
         "robot",
+        "stage",
         "outcome",
         "time",
         "steps",

@@ -82,7 +82,7 @@ class FrameRenderer:
         show_lidar: draw lidar hit points and the scanned area as a faint fan.
         show_trails: draw each robot's past positions (recorded across :meth:`render` calls, or
             taken from :attr:`Overlay.trails`).
-        title: text shown at the top centre of every frame.
+        title: text shown at the top right of every frame.
         margin_m: extra space around the map and obstacles (m).
         trail_length: how many past positions a recorded trail keeps.
         legend: draw the pedestrian social-state colour legend (bottom right).
@@ -250,12 +250,13 @@ class FrameRenderer:
             self._draw_legend()
         fontsize = self._font_size()
         if self.title:
+            # Top right: the top-left corner holds the time line.
             ax.text(
-                0.5,
+                1.0 - 8.0 / self.width_px,
                 1.0 - 8.0 / self.height_px,
                 self.title,
                 transform=ax.transAxes,
-                ha="center",
+                ha="right",
                 va="top",
                 fontsize=fontsize * 1.15,
                 color=style.TEXT,
@@ -264,7 +265,10 @@ class FrameRenderer:
             )
 
     def _draw_legend(self) -> None:
-        """Social-state colours, bottom right, in one boxed column of coloured dots."""
+        """Social-state colours, bottom right, in one boxed column of coloured dots.
+
+        Drawn under robots, goals and people (above the map) so it never hides them.
+        """
         ax = self._ax
         fs = self._font_size() * 0.8
         line = fs * 1.45 / 72.0 * _DPI  # pixels per legend row
@@ -282,7 +286,7 @@ class FrameRenderer:
                 va="center",
                 fontsize=fs,
                 color=style.TEXT,
-                zorder=20,
+                zorder=1.6,
             )
             ax.text(
                 x,
@@ -293,7 +297,7 @@ class FrameRenderer:
                 va="center",
                 fontsize=fs,
                 color=style.AGENT_STATE_COLORS[code],
-                zorder=21,
+                zorder=1.7,
             )
         top = (8.0 + line * len(names)) / self.height_px
         left = 1.0 - (8.0 + fs * 7.5 / 72.0 * _DPI) / self.width_px
@@ -306,7 +310,7 @@ class FrameRenderer:
                 facecolor=style.TEXT_BOX,
                 alpha=style.TEXT_BOX_ALPHA,
                 edgecolor="none",
-                zorder=19,
+                zorder=1.5,
             )
         )
 
