@@ -341,6 +341,16 @@ def default_zone_files(map_spec: Mapping[str, Any]) -> tuple[Path, Path] | None:
     return map_yaml.parent / "zones.yaml", folder / "zones" / "default.yaml"
 
 
+class ZoneFileParams(BaseModel):
+    """The two file parameters every zones mode takes."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    zones: str | None = Field(None, description="zones.yaml; default: the world's map/zones.yaml")
+    scenario: str | None = Field(
+        None, description="zone scenario YAML; default: the world's zones/default.yaml"
+    )
+
+
 class ZoneFiles:
     """Finds and caches the zone files a zones task mode uses.
 

@@ -20,28 +20,21 @@ them through the doors only as far as its wall forces let it.
 from __future__ import annotations
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn
-from arena.tasks.zones import ZoneFiles, sample_in_zones
+from arena.tasks.zones import ZoneFileParams, ZoneFiles, sample_in_zones
 
 
 @register_mode("obstacles", "zones", tags=("zones",))
 class ZoneObstacles:
     """Pedestrian groups of a zone scenario, starting and walking inside their zones."""
 
-    class Params(BaseModel):
+    class Params(ZoneFileParams):
         """Parameters of ``obstacles.zones``."""
 
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        zones: str | None = Field(
-            None, description="zones.yaml; default: the world's map/zones.yaml"
-        )
-        scenario: str | None = Field(
-            None, description="zone scenario YAML; default: the world's zones/default.yaml"
-        )
         agent_radius: float = Field(0.3, gt=0, description="m, pedestrian body radius")
         agent_speed: tuple[float, float] = Field((0.5, 1.2), description="m/s, [min, max] vmax")
         agent_robot_clearance: float = Field(

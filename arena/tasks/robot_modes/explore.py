@@ -18,7 +18,7 @@ from arena.core.errors import SamplingError
 from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import RobotSpawn
-from arena.tasks.robot_modes.random import robot_name, sample_start_goal
+from arena.tasks.robot_modes.random import random_spawns
 from arena.tasks.sampling import components
 from arena.tasks.world import WorldSampler
 
@@ -118,18 +118,7 @@ class ExploreRobots:
 
     def reset(self, ctx: ResetContext) -> list[RobotSpawn]:
         """Start and goal per robot, as ``robots.random`` draws them."""
-        p = self.params
-        rng = ctx.rng("robots")
-        n = len(ctx.robots)
-        spawns = []
-        for k, model in enumerate(ctx.robots):
-            name = robot_name(k, n, model.name)
-            start, goal = sample_start_goal(
-                ctx.sampler, model.radius + p.clearance, p.min_goal_distance, rng,
-                what=f"robot {name!r}",
-            )
-            spawns.append(RobotSpawn(name, model, start, goal))
-        return spawns
+        return random_spawns(ctx, self.params.min_goal_distance, self.params.clearance)
 
     def next_goal(
         self, ctx: ResetContext, robot: int, pose: Pose2D, rng: np.random.Generator

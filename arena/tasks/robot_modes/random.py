@@ -78,6 +78,22 @@ def sample_start_goal(
     )
 
 
+def random_spawns(
+    ctx: ResetContext, min_goal_distance: float, clearance: float
+) -> list[RobotSpawn]:
+    """A random start and goal for every robot of ``ctx`` (``clearance`` beyond its radius)."""
+    rng = ctx.rng("robots")
+    n = len(ctx.robots)
+    spawns = []
+    for k, model in enumerate(ctx.robots):
+        name = robot_name(k, n, model.name)
+        start, goal = sample_start_goal(
+            ctx.sampler, model.radius + clearance, min_goal_distance, rng, what=f"robot {name!r}"
+        )
+        spawns.append(RobotSpawn(name, model, start, goal))
+    return spawns
+
+
 @register_mode("robots", "random", tags=("default",))
 class RandomRobots(SingleGoal):
     """Random start and goal per robot, reachable for its body, ``min_goal_distance`` apart."""
@@ -96,17 +112,4 @@ class RandomRobots(SingleGoal):
 
     def reset(self, ctx: ResetContext) -> list[RobotSpawn]:
         """Start and goal for every robot model of the episode."""
-        p = self.params
-        rng = ctx.rng("robots")
-        n = len(ctx.robots)
-        spawns = []
-        for k, model in enumerate(ctx.robots):
-            start, goal = sample_start_goal(
-                ctx.sampler,
-                model.radius + p.clearance,
-                p.min_goal_distance,
-                rng,
-                what=f"robot {robot_name(k, n, model.name)!r}",
-            )
-            spawns.append(RobotSpawn(robot_name(k, n, model.name), model, start, goal))
-        return spawns
+        return random_spawns(ctx, self.params.min_goal_distance, self.params.clearance)

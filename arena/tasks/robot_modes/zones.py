@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
 from arena.core.errors import ConfigError, SamplingError
 from arena.core.types import Pose2D
@@ -22,7 +22,7 @@ from arena.tasks.episode import RobotSpawn
 from arena.tasks.robot_modes.random import robot_name
 from arena.tasks.sampling import components
 from arena.tasks.world import WorldSampler
-from arena.tasks.zones import RobotRole, ZoneFiles, ZoneMap, sample_in_zones
+from arena.tasks.zones import RobotRole, ZoneFileParams, ZoneFiles, ZoneMap, sample_in_zones
 
 
 def _masks(
@@ -46,16 +46,9 @@ def _masks(
 class ZoneRobots:
     """Robots with zone-scenario roles: start and endless goals inside the role's zones."""
 
-    class Params(BaseModel):
+    class Params(ZoneFileParams):
         """Parameters of ``robots.zones``."""
 
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        zones: str | None = Field(
-            None, description="zones.yaml; default: the world's map/zones.yaml"
-        )
-        scenario: str | None = Field(
-            None, description="zone scenario YAML; default: the world's zones/default.yaml"
-        )
         clearance: float = Field(
             0.25, ge=0, description="m kept beyond the robot radius (Arena SPAWN_ROBOT_SAFE_DIST)"
         )
