@@ -5,6 +5,8 @@ planners arrive through the ``arena.global_planners`` entry-point group.
 """
 
 from arena.nav.global_planners import astar as _astar  # noqa: F401  (registers "astar")
+from arena.nav.global_planners import dijkstra as _dijkstra  # noqa: F401  (registers "dijkstra")
+from arena.nav.global_planners import theta_star as _theta  # noqa: F401  (registers "theta_star")
 from arena.nav.global_planners.astar import AStarPlanner, segment_is_free
 from arena.nav.global_planners.base import (
     GLOBAL_PLANNERS,
@@ -12,12 +14,17 @@ from arena.nav.global_planners.base import (
     endpoint_cells,
     path_length,
 )
+from arena.nav.global_planners.dijkstra import DijkstraPlanner, plan_on_costmap
+from arena.nav.global_planners.theta_star import ThetaStarPlanner
 
 __all__ = [
     "GLOBAL_PLANNERS",
     "AStarPlanner",
+    "DijkstraPlanner",
     "GlobalPlanner",
+    "ThetaStarPlanner",
     "endpoint_cells",
     "path_length",
+    "plan_on_costmap",
     "segment_is_free",
 ]
