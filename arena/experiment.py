@@ -38,6 +38,7 @@ from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
 from arena.maps.raster import polygon_mask
+from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack
 from arena.robots.model import RobotModel
@@ -285,7 +286,12 @@ def run_episode(
                 time=state.time,
                 kinematics=robot.kinematics_type,
             )
-            cmd = np.asarray(stack.step(obs), dtype=np.float64)
+            agents = state.agents
+            peds = Pedestrians(
+                positions=agents.positions, velocities=agents.velocities,
+                kinds=agents.kinds, states=agents.states,
+            )
+            cmd = np.asarray(stack.step(obs, peds), dtype=np.float64)
             if cmd.shape != (3,) or not np.all(np.isfinite(cmd)):
                 raise ArenaError(f"the navigation stack returned an invalid command {cmd!r}")
             if realtime:

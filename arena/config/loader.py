@@ -192,6 +192,7 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
     from arena.crowd.base import CROWD_MODELS
     from arena.maps.sources import MAP_SOURCES
     from arena.nav.global_planners.base import GLOBAL_PLANNERS
+    from arena.nav.intermediate.base import INTERMEDIATE_PLANNERS
     from arena.nav.local_planners.base import LOCAL_PLANNERS
     from arena.robots.presets import load_robot
     from arena.sim.backend import BACKENDS
@@ -206,6 +207,10 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
     BACKENDS.validate(cfg.sim.backend, source=source, path="sim.backend")
     GLOBAL_PLANNERS.validate(
         cfg.navigation.global_planner, source=source, path="navigation.global_planner"
+    )
+    INTERMEDIATE_PLANNERS.validate(
+        cfg.navigation.intermediate_planner, source=source,
+        path="navigation.intermediate_planner",
     )
     local, _ = LOCAL_PLANNERS.validate(
         cfg.navigation.local_planner, source=source, path="navigation.local_planner"

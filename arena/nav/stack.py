@@ -3,8 +3,10 @@
 Data flow per episode: :meth:`NavigationStack.reset` inflates the static map once by
 ``robot_radius + inflation_margin`` and plans a global path; every control tick
 :meth:`NavigationStack.step` checks the goal, replans when due, and asks the local planner for a
-body-frame command. A later layer (costmaps, intermediate planners) slots in between without
-changing this interface.
+body-frame command. An intermediate planner (:mod:`arena.nav.intermediate`) sits between the two:
+every ``intermediate_period`` seconds it sees the global path and the pedestrians (passed to
+:meth:`NavigationStack.step`) and returns the path the local planner follows plus parameter
+overrides (e.g. ``max_speed``). The default ``bypass`` leaves both untouched.
 
 Policies (documented here because tasks and metrics depend on them):
 
@@ -29,6 +31,11 @@ Policies (documented here because tasks and metrics depend on them):
   pursuit) align the heading at the goal. Car-like (Ackermann) robots cannot turn on the spot:
   they reach a goal heading only if the approach happens to end with it. The status then stays
   ``GOAL_REACHED``.
+- **Parameter overrides** from the intermediate planner apply to the local planner when it has a
+  pydantic ``params`` model with a field of that name (pure pursuit: ``max_speed``), else an
+  attribute of that name; other keys are ignored. Each output replaces the previous overrides
+  (values not overridden return to the configured ones); :meth:`NavigationStack.reset` restores
+  the configured parameters.
 """
 
 from __future__ import annotations
@@ -49,6 +56,12 @@ from arena.core.geometry import point_segment_distance
 from arena.core.types import Pose2D, wrap_angle_scalar
 from arena.maps.grid import OccupancyGrid
 from arena.nav.global_planners import GLOBAL_PLANNERS, GlobalPlanner, segment_is_free
+from arena.nav.intermediate import (
+    INTERMEDIATE_PLANNERS,
+    IntermediateInput,
+    IntermediatePlanner,
+    Pedestrians,
+)
 from arena.nav.local_planners import (
     LOCAL_PLANNERS,
     LocalObservation,
@@ -86,6 +99,16 @@ class NavigationConfig(BaseModel):
         default_factory=lambda: {"type": "pure_pursuit"},
         description="local planner block {type: name, **params}",
     )
+    intermediate_planner: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "bypass"},
+        description="intermediate planner block {type: name, **params}",
+    )
+    intermediate_period: float = Field(
+        0.0, ge=0, description="s between intermediate-planner calls; 0 = every control tick"
+    )
+    intermediate_window: float = Field(
+        5.0, gt=0, description="m, radius of the local window given to the intermediate planner"
+    )
     replan_period: float = Field(1.0, ge=0, description="s between global replans; 0 = never")
     inflation_margin: float = Field(
         0.05, ge=0, description="m of clearance added to the robot radius when inflating the map"
@@ -101,7 +124,7 @@ class NavigationConfig(BaseModel):
     # The planner blocks are checked against their registries where the file and key path are
     # known (the experiment loader, :meth:`NavigationStack.from_config`), not here: a pydantic
     # error would lose the UnknownNameError type and the exact key path inside the block.
-    @field_validator("global_planner", "local_planner", mode="before")
+    @field_validator("global_planner", "local_planner", "intermediate_planner", mode="before")
     @classmethod
     def _shorthand(cls, v: Any) -> Any:
         return _planner_block(v)
@@ -123,6 +146,9 @@ class NavigationStack:
         max_path_deviation: distance from the path (m) that triggers an immediate replan.
         kinematics: the robot's kinematics name; checked against the local planner's
             ``supports`` and passed on in every observation. ``None`` lets the planner infer it.
+        intermediate_planner: refines the path between the two; ``None`` = ``bypass``.
+        intermediate_period: seconds between intermediate-planner calls; 0 = every tick.
+        intermediate_window: radius (m) of the local window given to the intermediate planner.
 
     Raises:
         ConfigError: the local planner cannot drive ``kinematics``, or an argument is invalid.
@@ -142,6 +168,9 @@ class NavigationStack:
         ),
         max_path_deviation: float = _DEFAULTS.max_path_deviation,
         kinematics: str | None = None,
+        intermediate_planner: IntermediatePlanner | None = None,
+        intermediate_period: float = _DEFAULTS.intermediate_period,
+        intermediate_window: float = _DEFAULTS.intermediate_window,
     ) -> None:
         if not robot_radius > 0:
             raise ConfigError(f"robot_radius must be > 0 m, got {robot_radius}")
@@ -149,6 +178,11 @@ class NavigationStack:
             raise ConfigError(
                 "inflation_margin and replan_period must be >= 0 and max_path_deviation > 0, got "
                 f"{inflation_margin}, {replan_period}, {max_path_deviation}"
+            )
+        if intermediate_period < 0 or not intermediate_window > 0:
+            raise ConfigError(
+                "intermediate_period must be >= 0 and intermediate_window > 0, got "
+                f"{intermediate_period}, {intermediate_window}"
             )
         supports = getattr(local_planner, "supports", frozenset())
         if kinematics is not None and kinematics not in supports:
@@ -176,6 +210,18 @@ class NavigationStack:
         self._time = 0.0
         self._last_plan_time = 0.0
         self._retry_after = -math.inf
+        self.intermediate_planner: IntermediatePlanner = (
+            intermediate_planner
+            if intermediate_planner is not None
+            else INTERMEDIATE_PLANNERS.build("bypass")
+        )
+        self.intermediate_period = float(intermediate_period)
+        self.intermediate_window = float(intermediate_window)
+        self.overrides: dict[str, float] = {}
+        self._base_params = getattr(local_planner, "params", None)
+        self._base_attrs: dict[str, Any] = {}
+        self._inter_path: NDArray[np.float64] | None = None
+        self._inter_time = -math.inf
 
     @classmethod
     def from_config(
@@ -206,7 +252,11 @@ class NavigationStack:
             raw = dict(cfg)
             # Check the planner blocks through their registries first: their errors keep their
             # type (UnknownNameError with a close match) and the exact key path.
-            blocks = (("global_planner", GLOBAL_PLANNERS), ("local_planner", LOCAL_PLANNERS))
+            blocks: tuple[tuple[str, Any], ...] = (
+                ("global_planner", GLOBAL_PLANNERS),
+                ("local_planner", LOCAL_PLANNERS),
+                ("intermediate_planner", INTERMEDIATE_PLANNERS),
+            )
             for key, registry in blocks:
                 if key in raw:
                     spec = raw[key]
@@ -220,12 +270,17 @@ class NavigationStack:
                 raise from_validation_error(e, source=source, prefix=path) from None
         gp = GLOBAL_PLANNERS.build(cfg.global_planner, source=source, path=sub("global_planner"))
         lp = LOCAL_PLANNERS.build(cfg.local_planner, source=source, path=sub("local_planner"))
+        ip = INTERMEDIATE_PLANNERS.build(
+            cfg.intermediate_planner, source=source, path=sub("intermediate_planner")
+        )
         try:
             return cls(
                 gp, lp, robot_radius=robot_radius, inflation_margin=cfg.inflation_margin,
                 replan_period=cfg.replan_period,
                 goal_tolerance=(cfg.goal_tolerance_xy, cfg.goal_tolerance_yaw),
                 max_path_deviation=cfg.max_path_deviation, kinematics=kinematics,
+                intermediate_planner=ip, intermediate_period=cfg.intermediate_period,
+                intermediate_window=cfg.intermediate_window,
             )
         except ConfigError as e:
             raise e.located(source=source, prefix=path) from None
@@ -288,6 +343,10 @@ class NavigationStack:
         self.grid = grid
         self.goal = goal
         self.local_planner.reset()
+        self.intermediate_planner.reset()
+        self._apply_overrides({})
+        self._inter_path = None
+        self._inter_time = -math.inf
         self._path = np.zeros((0, 2))
         self._path.setflags(write=False)
         self._time = float(time)
@@ -320,7 +379,9 @@ class NavigationStack:
             return False
         return True
 
-    def step(self, obs: LocalObservation) -> NDArray[np.float64]:
+    def step(
+        self, obs: LocalObservation, pedestrians: Pedestrians | None = None
+    ) -> NDArray[np.float64]:
         """One control tick: check the goal, replan if due, return the local planner's command.
 
         Args:
@@ -328,6 +389,8 @@ class NavigationStack:
                 stack's own (the caller may pass :attr:`path` or an empty array); ``kinematics``
                 falls back to the stack's when ``None``. ``obs.time`` (s) drives the replanning
                 period, so it must advance.
+            pedestrians: pedestrians around the robot (world frame), for the intermediate
+                planner; ``None`` means none known.
 
         Returns:
             ``(3,)`` body twist command ``[vx, vy, omega]``; a braking command (zero within the
@@ -350,8 +413,9 @@ class NavigationStack:
         if due or strayed:
             self.replan(Pose2D.from_array(q))
 
+        path = self._intermediate(obs, q, v, pedestrians)
         local_obs = dataclasses.replace(
-            obs, path=self._path, goal=self.goal,
+            obs, path=path, goal=self.goal,
             kinematics=obs.kinematics if obs.kinematics is not None else self.kinematics,
             goal_yaw_tolerance=(
                 obs.goal_yaw_tolerance
@@ -361,7 +425,76 @@ class NavigationStack:
         )
         return np.asarray(self.local_planner.compute(local_obs), dtype=np.float64).reshape(3)
 
+    @property
+    def intermediate_path(self) -> NDArray[np.float64]:
+        """The path the local planner followed at the last :meth:`step` (m, ``(m, 2)``)."""
+        return self._inter_path if self._inter_path is not None else self._path
+
     # -- internals ------------------------------------------------------------------------------
+    def _base_speed(self, obs: LocalObservation) -> float:
+        """The local planner's configured cruise speed (m/s): its ``max_speed`` or ``vx_max``."""
+        configured = getattr(self._base_params, "max_speed", None)
+        if configured is None:
+            current = getattr(self.local_planner, "max_speed", None)
+            configured = self._base_attrs.get("max_speed", current)
+        vmax = float(obs.limits.vx_max)
+        return min(vmax, float(configured)) if isinstance(configured, int | float) else vmax
+
+    def _intermediate(
+        self,
+        obs: LocalObservation,
+        q: NDArray[np.float64],
+        v: NDArray[np.float64],
+        pedestrians: Pedestrians | None,
+    ) -> NDArray[np.float64]:
+        """Call the intermediate planner when due; return the path for the local planner."""
+        due = self._inter_path is None or (
+            self._time - self._inter_time >= self.intermediate_period - 1e-9
+        )
+        if not due:
+            assert self._inter_path is not None
+            return self._inter_path
+        points = obs.scan_points() if np.size(obs.scan_ranges) else np.zeros((0, 2))
+        if len(points):
+            c, s = math.cos(q[2]), math.sin(q[2])
+            points = points @ np.array([[c, s], [-s, c]]) + q[:2]
+        inp = IntermediateInput(
+            pose=q, twist=v, path=self._path, goal=self.goal.as_array(),
+            max_speed=self._base_speed(obs), robot_radius=self.robot_radius,
+            pedestrians=pedestrians if pedestrians is not None else Pedestrians(),
+            obstacle_points=points, window=self.intermediate_window, time=self._time,
+        )
+        out = self.intermediate_planner.plan(inp)
+        if out.path is self._path:
+            path = self._path
+        else:
+            path = np.array(out.path, dtype=np.float64).reshape(-1, 2)
+            path.setflags(write=False)
+        self._apply_overrides(dict(out.overrides))
+        self._inter_path = path
+        self._inter_time = self._time
+        return path
+
+    def _apply_overrides(self, overrides: dict[str, float]) -> None:
+        """Set the local planner's parameters to the configured ones updated by ``overrides``."""
+        if overrides == self.overrides:
+            return
+        lp = self.local_planner
+        base = self._base_params
+        fields = type(base).model_fields if isinstance(base, BaseModel) else {}
+        in_params = {k: val for k, val in overrides.items() if k in fields}
+        if isinstance(base, BaseModel):
+            new = base.model_copy(update=in_params) if in_params else base
+            lp.params = new  # type: ignore[attr-defined]
+        for k in list(self._base_attrs):
+            if k not in overrides:
+                setattr(lp, k, self._base_attrs.pop(k))
+        for k, val in overrides.items():
+            if k not in fields and hasattr(lp, k) and not callable(getattr(lp, k)):
+                self._base_attrs.setdefault(k, getattr(lp, k))
+                setattr(lp, k, val)
+        self.overrides = dict(overrides)
+
     def _require_reset(self) -> None:
         if self.inflated is None:
             raise RuntimeError("NavigationStack.reset(grid, start, goal) must be called first")

@@ -24,6 +24,7 @@ COVERED = {
     "kinematics": "tests/robots/test_kinematics.py",
     "global planner": "tests/conformance/test_planners_conformance.py",
     "local planner": "tests/conformance/test_planners_conformance.py",
+    "intermediate planner": "tests/conformance/test_intermediate_conformance.py",
     "robot": "tests/robots/test_presets.py",
     "map generator": "here",
 }
