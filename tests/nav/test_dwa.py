@@ -1,0 +1,181 @@
+"""DWA: dynamic-window limits, goal reaching, stopping before obstacles, car turning radius."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from arena.config import load_config
+from arena.core.types import Pose2D
+from arena.experiment import run_experiment
+from arena.nav.local_planners import LOCAL_PLANNERS, DWAPlanner, LocalObservation
+from arena.robots.kinematics import integrate_twist
+from arena.robots.limits import VelocityLimits
+
+DT = 0.1
+RADIUS = 0.3
+DIFF = VelocityLimits(0.0, 1.0, 0.0, 0.0, 1.5, 1.0, 0.0, 3.0)
+OMNI = VelocityLimits(-0.8, 0.8, -0.6, 0.6, 1.2, 1.0, 1.0, 2.0)
+CAR = VelocityLimits(0.0, 1.5, 0.0, 0.0, 1.5, 1.0, 0.0, 2.0, min_turning_radius=1.2)
+LEGGED = VelocityLimits(-0.3, 0.7, 0.0, 0.0, 1.0, 0.8, 0.0, 2.0)
+DRIVES = {"diff_drive": DIFF, "omni": OMNI, "ackermann": CAR, "legged": LEGGED}
+
+
+def _dwa(**kw: object) -> DWAPlanner:
+    planner = LOCAL_PLANNERS.build({"type": "dwa", **kw})
+    assert isinstance(planner, DWAPlanner)
+    return planner
+
+
+def _obs(pose, path, twist=(0.0, 0.0, 0.0), limits=DIFF, kin="diff_drive", ranges=None,
+         angles=None) -> LocalObservation:
+    path = np.asarray(path, dtype=float)
+    return LocalObservation(
+        pose=np.asarray(pose, dtype=float), twist=np.asarray(twist, dtype=float),
+        goal=Pose2D(*path[-1]), path=path, limits=limits, robot_radius=RADIUS, dt=DT,
+        scan_ranges=np.zeros(0) if ranges is None else np.asarray(ranges, dtype=float),
+        scan_angles=np.zeros(0) if angles is None else np.asarray(angles, dtype=float),
+        kinematics=kin,
+    )
+
+
+def _line(x0: float, x1: float, n: int = 50) -> np.ndarray:
+    return np.stack([np.linspace(x0, x1, n), np.zeros(n)], axis=-1)
+
+
+def _step(pose: np.ndarray, cmd: np.ndarray) -> np.ndarray:
+    return integrate_twist(pose[None, :], cmd[None, :], DT)[0]
+
+
+def _wall_scan(pose: np.ndarray, wall_x: float, n: int = 360) -> tuple[np.ndarray, np.ndarray]:
+    """Ranges of a wall ``x = wall_x`` (world) seen from ``pose``, 8 m max range."""
+    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
+    world = angles + pose[2]
+    with np.errstate(divide="ignore"):
+        t = (wall_x - pose[0]) / np.cos(world)
+    return np.where((t > 0) & (t < 8.0), t, np.inf), angles
+
+
+@pytest.mark.parametrize("kin", sorted(DRIVES))
+def test_commands_stay_in_the_dynamic_window(kin: str) -> None:
+    lim = DRIVES[kin]
+    rng = np.random.default_rng(3)
+    planner = _dwa()
+    for _ in range(30):
+        twist = rng.uniform(lim.lower, lim.upper)
+        if not lim.holonomic:
+            twist[1] = 0.0
+        if kin == "ackermann":
+            twist[0] = abs(twist[0])
+            twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
+        pose = rng.uniform([-1, -1, -3], [1, 1, 3])
+        path = np.vstack([pose[:2], pose[:2] + rng.normal(0, 2, (3, 2)).cumsum(axis=0)])
+        ranges = rng.uniform(0.4, 5.0, 90)
+        angles = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+        cmd = planner.compute(_obs(pose, path, twist, lim, kin, ranges, angles))
+        room = lim.acceleration * DT + 1e-9
+        assert np.all(cmd >= lim.lower - 1e-9) and np.all(cmd <= lim.upper + 1e-9)
+        assert abs(cmd[0] - twist[0]) <= room[0] and abs(cmd[1] - twist[1]) <= room[1]
+        if kin == "ackermann":
+            assert abs(cmd[2]) <= abs(cmd[0]) / lim.min_turning_radius + 1e-9
+        else:
+            assert abs(cmd[2] - twist[2]) <= room[2]
+
+
+@pytest.mark.parametrize("kin", ["diff_drive", "omni", "legged"])
+def test_reaches_a_goal_behind_and_aside(kin: str) -> None:
+    lim = DRIVES[kin]
+    planner = _dwa()
+    path = np.array([[0.0, 0.0], [-1.0, 2.0], [-3.0, 2.5]])
+    pose, twist = np.array([0.0, 0.0, 0.0]), np.zeros(3)
+    for _ in range(400):
+        cmd = planner.compute(_obs(pose, path, twist, lim, kin))
+        pose, twist = _step(pose, cmd), cmd
+    assert np.linalg.norm(pose[:2] - path[-1]) < 0.1
+    assert np.allclose(twist, 0.0, atol=0.3)
+
+
+def test_stops_before_a_wall() -> None:
+    planner = _dwa()
+    path = _line(0.0, 6.0)
+    pose, twist = np.zeros(3), np.array([0.8, 0.0, 0.0])
+    for _ in range(200):
+        ranges, angles = _wall_scan(pose, 3.0)
+        cmd = planner.compute(_obs(pose, path, twist, DIFF, "diff_drive", ranges, angles))
+        pose, twist = _step(pose, cmd), cmd
+        assert 3.0 - pose[0] > RADIUS  # never touches the wall
+    assert abs(twist[0]) < 1e-9
+    assert 3.0 - pose[0] - RADIUS < 0.6  # got reasonably close: it did not stop early
+
+
+def test_ackermann_respects_the_turning_radius() -> None:
+    planner = _dwa()
+    # A left turn of radius 2 m (feasible for the car) ending behind the start.
+    t = np.linspace(0.0, math.pi, 60)
+    path = np.stack([2.0 * np.sin(t), 2.0 * (1.0 - np.cos(t))], axis=-1)
+    pose, twist = np.zeros(3), np.zeros(3)
+    moved = False
+    for _ in range(150):
+        cmd = planner.compute(_obs(pose, path, twist, CAR, "ackermann"))
+        assert abs(cmd[2]) <= abs(cmd[0]) / CAR.min_turning_radius + 1e-9
+        moved |= cmd[0] > 0.1
+        pose, twist = _step(pose, cmd), cmd
+    assert moved
+    assert np.linalg.norm(pose[:2] - path[-1]) < 0.5
+
+
+def test_samples_of_a_car_follow_curvature_bounds() -> None:
+    planner = _dwa()
+    samples = planner.samples(_obs(np.zeros(3), _line(0, 3), (0.5, 0, 0), CAR, "ackermann"))
+    assert np.all(np.abs(samples[:, 2]) <= samples[:, 0] / CAR.min_turning_radius + 1e-12)
+    assert np.all(samples[:, 1] == 0.0)
+
+
+def test_deterministic_and_reset() -> None:
+    rng = np.random.default_rng(7)
+    ranges = rng.uniform(0.5, 4.0, 180)
+    angles = np.linspace(-math.pi, math.pi, 180, endpoint=False)
+    obs = _obs([0, 0, 0.3], _line(0, 5), (0.3, 0, 0.1), DIFF, "diff_drive", ranges, angles)
+    a = _dwa().compute(obs)
+    planner = _dwa()
+    planner.compute(_obs([1, 1, 0], _line(0, 5)))
+    planner.reset()
+    np.testing.assert_array_equal(planner.compute(obs), a)
+
+
+def test_reverse_only_when_allowed() -> None:
+    path = np.array([[0.0, 0.0], [-3.0, 0.0]])
+    cmd = _dwa().compute(_obs([0, 0, 0], path, (0, 0, 0), LEGGED, "legged"))
+    assert cmd[0] >= 0.0
+    samples = _dwa(allow_reverse=True).samples(_obs([0, 0, 0], path, (0, 0, 0), LEGGED, "legged"))
+    assert samples[:, 0].min() < 0.0
+
+
+def test_compute_time_per_cycle() -> None:
+    # A jackal-like 720-beam scan in a room; the average cycle must stay well under 50 ms.
+    planner = _dwa()
+    angles = np.linspace(-2.356, 2.356, 720)
+    ranges = 2.0 / np.maximum(np.abs(np.cos(angles)), 0.3)
+    lim = VelocityLimits(-2.0, 2.0, 0.0, 0.0, 4.0, 20.0, 0.0, 25.0)
+    obs = _obs([0, 0, 0], _line(0, 5), (0.5, 0, 0), lim, "diff_drive", ranges, angles)
+    planner.compute(obs)  # compile / warm up
+    t0 = time.perf_counter()
+    for _ in range(20):
+        planner.compute(obs)
+    per_cycle = (time.perf_counter() - t0) / 20
+    assert per_cycle < 0.05
+
+
+def test_jackal_reaches_the_goal_in_an_empty_room(tmp_path: Path) -> None:
+    cfg = load_config(None, [
+        "navigation.local_planner.type=dwa", "map.type=empty", "task.obstacles.static=0",
+        "task.obstacles.dynamic=0", "task.timeout=40", "output.video=false", "episodes=5",
+        "task.robots.min_goal_distance=5",
+    ])
+    _, results = run_experiment(cfg, tmp_path)
+    assert [r.outcome for r in results] == ["success"] * 5
+    assert all(r.collisions == 0 for r in results)
