@@ -90,6 +90,21 @@ def test_polite_backs_away_from_a_pedestrian_in_front_until_the_temp_goal():
     assert p.plan(_inp(pose=(1.0, -0.8, math.pi / 2))).path is PATH
 
 
+@pytest.mark.parametrize(("cooldown", "retreats_again"), [(4.0, False), (0.0, True)])
+def test_polite_retreat_cooldown(cooldown, retreats_again):
+    p = PolitePlanner(PolitePlanner.Params(retreat_cooldown=cooldown))
+    ped = [(1.0, 1.0)]  # 1 m ahead of a robot facing +x
+    assert p.plan(_inp(ped, time=0.0)).info["mode"] == "polite_retreat"
+    # Arrived at the temporary goal 2 m behind at t = 3 s: the retreat ends.
+    assert p.plan(_inp(pose=(-2.0, 0.0, 0.0), time=3.0)).path is PATH
+    # The person still stands 1.5 m in front at t = 4 s.
+    out = p.plan(_inp([(-0.5, 0.0)], pose=(-2.0, 0.0, 0.0), time=4.0))
+    assert (out.info["mode"] == "polite_retreat") is retreats_again
+    # After the cooldown the robot yields again.
+    later = p.plan(_inp([(-0.5, 0.0)], pose=(-2.0, 0.0, 0.0), time=7.5))
+    assert later.info["mode"] == "polite_retreat"
+
+
 def test_polite_ignores_people_behind_and_respects_its_thresholds():
     assert PolitePlanner().plan(_inp([(-1.0, 0.0)])).path is PATH  # behind: outside the fov
     narrow = PolitePlanner(PolitePlanner.Params(fov=math.pi / 4))

@@ -184,6 +184,11 @@ class _RetreatParams(BaseModel):
     danger_threshold: float = Field(
         0.6, ge=0, le=1, description="danger level above which the danger signal is raised"
     )
+    retreat_cooldown: float = Field(
+        4.0, ge=0,
+        description="s after a retreat ends during which no new retreat starts (ours; Arena: 0, "
+        "which lets a robot facing a standing group retreat over and over and never arrive)",
+    )
 
 
 class _Retreat:
@@ -192,6 +197,11 @@ class _Retreat:
     params: _RetreatParams
     _padding: float
     _temp: FloatArray | None
+    _retreat_end: float = -math.inf
+
+    def _end_retreat(self, inp: IntermediateInput) -> None:
+        self._temp = None
+        self._retreat_end = float(inp.time)
 
     def _speed(self, inp: IntermediateInput, d: FloatArray) -> dict[str, float]:
         if d.size and float(d.min()) <= self.params.caution_detection_range:
@@ -199,6 +209,8 @@ class _Retreat:
         return {}
 
     def _triggered(self, inp: IntermediateInput, d: FloatArray) -> bool:
+        if float(inp.time) < self._retreat_end + self.params.retreat_cooldown - 1e-9:
+            return False
         near = d <= self.params.ped_minimum_distance
         if not near.any():
             return False
@@ -230,6 +242,7 @@ class PolitePlanner(_Retreat):
       ``temp_goal_distance`` m straight behind the robot replaces the path until the robot is
       within ``temp_goal_tolerance`` of it; it is abandoned (normal path again) when a laser
       return toward it is closer than ``min(temp_goal_distance, 2·robot_radius + 0.075)``.
+    - No new retreat for ``retreat_cooldown`` s after one ended (our addition; Arena has none).
     """
 
     class Params(_RetreatParams):
@@ -243,8 +256,9 @@ class PolitePlanner(_Retreat):
         self.reset()
 
     def reset(self) -> None:
-        """Drop the temporary goal."""
+        """Drop the temporary goal and the cooldown."""
         self._temp = None
+        self._retreat_end = -math.inf
 
     def plan(self, inp: IntermediateInput) -> IntermediateOutput:
         """The global path or the retreat to the temporary goal, and the speed override."""
@@ -260,7 +274,7 @@ class PolitePlanner(_Retreat):
             float(np.hypot(*(self._temp - xy))) <= self.params.temp_goal_tolerance
             or self._blocked(inp, self._temp)
         ):
-            self._temp = None
+            self._end_retreat(inp)
         if self._temp is None:
             return IntermediateOutput(path=inp.path, overrides=overrides, info=info)
         info["mode"] = "polite_retreat"
@@ -305,9 +319,10 @@ class SidewaysPlanner(_Retreat):
         self.reset()
 
     def reset(self) -> None:
-        """Drop the temporary goal and the wait timer."""
+        """Drop the temporary goal, the wait timer and the cooldown."""
         self._temp = None
         self._wait_until: float | None = None
+        self._retreat_end = -math.inf
 
     def plan(self, inp: IntermediateInput) -> IntermediateOutput:
         """The global path, the step aside, or standing still; and the speed override."""
@@ -328,8 +343,10 @@ class SidewaysPlanner(_Retreat):
             float(np.hypot(*(self._temp - xy))) <= self.params.temp_goal_tolerance
             or self._blocked(inp, self._temp)
         ):
-            self._temp = None
             self._wait_until = float(inp.time) + self.params.wait_time
+            self._temp = None
+            # The cooldown starts when the robot moves on again, after the wait.
+            self._retreat_end = self._wait_until
             info["mode"] = "sideways_wait"
             return IntermediateOutput(path=xy[None, :], overrides={"max_speed": 0.0}, info=info)
         if self._temp is None:
