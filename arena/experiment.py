@@ -40,7 +40,7 @@ from arena.crowd.simulator import CrowdSimulator
 from arena.maps.raster import polygon_mask
 from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
-from arena.nav.stack import NavigationStack
+from arena.nav.stack import NavigationStack, NavStatus
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.sim.backend import BACKENDS, SimulatorBackend
@@ -70,6 +70,9 @@ class EpisodeResult:
     error: str = ""
     goals_reached: int = 0
     teleports: int = 0
+    control_ms_mean: float = 0.0
+    control_ms_p95: float = 0.0
+    control_ms_max: float = 0.0
     files: dict[str, str] = field(default_factory=dict)
 
 
@@ -219,6 +222,10 @@ def run_episode(
     (``goal_tolerance_angle``), the heading too; robots that can turn on the spot then align
     their heading at the goal. Car-like (Ackermann) robots cannot, so a heading tolerance is
     met by them only when the approach ends with it.
+
+    When the stack reports ``STUCK`` (oscillation detected and every recovery behaviour of
+    ``navigation.recovery_behaviors`` tried, see :mod:`arena.nav.recovery`), the episode ends
+    at once as ``stuck``.
     """
     if runtime is None:
         runtime = TaskRuntime.single_goal(episode)
@@ -229,6 +236,7 @@ def run_episode(
     crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
     state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
     stack = NavigationStack.from_config(cfg.navigation, robot_radius=robot.radius)
+    stack.scan_range_max = float(robot.laser.range_max)
     stack.goal_tolerance_xy = min(stack.goal_tolerance_xy, 0.9 * episode.goal_radius)
     if episode.goal_tolerance_angle is not None:
         stack.goal_tolerance_yaw = float(episode.goal_tolerance_angle)
@@ -240,6 +248,7 @@ def run_episode(
     goal = spawn.goal
 
     recorder = EpisodeRecorder()
+    control_s: list[float] = []  # wall time of each navigation-stack call (global+inter+local)
     recorder.record(state)
     states = [state] if video else []
     outcome, error = Outcome.TIMEOUT, ""
@@ -291,7 +300,12 @@ def run_episode(
                 positions=agents.positions, velocities=agents.velocities,
                 kinds=agents.kinds, states=agents.states,
             )
+            t_ctl = time.perf_counter()
             cmd = np.asarray(stack.step(obs, peds), dtype=np.float64)
+            control_s.append(time.perf_counter() - t_ctl)
+            if stack.status is NavStatus.STUCK:  # every recovery behaviour failed
+                outcome = Outcome.STUCK
+                break
             if cmd.shape != (3,) or not np.all(np.isfinite(cmd)):
                 raise ArenaError(f"the navigation stack returned an invalid command {cmd!r}")
             if realtime:
@@ -336,6 +350,11 @@ def run_episode(
         goals_reached=runtime.goals_reached[0],
         teleports=runtime.teleports[0],
     )
+    if control_s:
+        ms = 1e3 * np.array(control_s)
+        result.control_ms_mean = float(ms.mean())
+        result.control_ms_p95 = float(np.percentile(ms, 95))
+        result.control_ms_max = float(ms.max())
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)
         result.files.update(recorder.write(out_dir))
@@ -456,6 +475,8 @@ def _write_summary(path: Path, results: list[EpisodeResult]) -> None:
         "goals_reached",
         "teleports",
         "final_goal_distance",
+        "control_ms_mean",
+        "control_ms_p95",
         "wall_time",
         "error",
     ]

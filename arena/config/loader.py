@@ -145,7 +145,13 @@ def _apply(data: dict[str, Any], key: str, value: Any, text: str) -> dict[str, A
     node: Any = data
     parts = key.split(".")
     for i, part in enumerate(parts[:-1]):
-        if isinstance(node, dict) and part in node and not isinstance(node[part], dict):
+        # An optional block left unset (None) is opened by setting one of its keys.
+        if (
+            isinstance(node, dict)
+            and part in node
+            and node[part] is not None
+            and not isinstance(node[part], dict)
+        ):
             raise ConfigError(
                 f"cannot set {key!r}: {'.'.join(parts[: i + 1])!r} is a value, not a block",
                 source=f"override {text!r}",

@@ -36,6 +36,32 @@ Policies (documented here because tasks and metrics depend on them):
   attribute of that name; other keys are ignored. Each output replaces the previous overrides
   (values not overridden return to the configured ones); :meth:`NavigationStack.reset` restores
   the configured parameters.
+
+move_base_flex-like features (all opt-in; with the defaults the stack behaves as before):
+
+- **Rates.** The global planner runs at reset, every ``replan_period`` s, on deviation, and at
+  once when the path ahead is blocked (``replan_on_blocked``); the intermediate planner every
+  ``intermediate_period`` s; the local planner every control tick (``step``).
+- **Global costmap** (``navigation.global_costmap: {...}``). The global plan is made on a
+  :class:`~arena.nav.costmap.GlobalCostmap` of the static map, inflated with inscribed radius
+  ``robot_radius + inflation_margin`` (its lethal/inscribed cells are exactly the inflated map's
+  occupied cells) and a decaying cost out to ``inflation_radius``. With ``cost_weight > 0`` the
+  cost-aware search :func:`~arena.nav.global_planners.plan_on_costmap` plans (keeping clear of
+  walls); with 0 the configured global planner plans on the lethal cells. ``use_scan: true``
+  folds every scan into its obstacle layer (marks persist until raytraced free or cleared).
+- **Local costmap** (``navigation.local_costmap: {...}``): a rolling window updated every tick
+  from the scan (and pedestrians), given to the local planner as ``LocalObservation.costmap``.
+- **Blocked path.** With ``replan_on_blocked`` the next ``blocked_lookahead`` m of path are
+  checked every tick (at most one blocked replan per 0.5 s): a laser return within
+  ``robot_radius`` of the path, or an inscribed/lethal local-costmap cell on it, triggers a
+  replan with the current scan marked on the planning grid (inflated like the map; in the
+  global costmap: folded into its obstacle layer). Periodic replans then keep marking the scan
+  so the path does not flip back. Readings at ``scan_range_max`` count as no return.
+- **Oscillation and recovery.** With ``oscillation_timeout > 0`` a robot that has not moved
+  ``oscillation_distance`` m within that time runs the next of ``recovery_behaviors``
+  (``clear_costmap``, ``rotate``, ``back_up``; see :mod:`arena.nav.recovery`); the status is
+  ``RECOVERING`` during a motion recovery. Once every behaviour has run without the robot
+  getting away, the status becomes ``STUCK`` (commands only brake; the episode ends ``stuck``).
 """
 
 from __future__ import annotations
@@ -55,7 +81,20 @@ from arena.core.errors import ConfigError, PlanningError, StartOccupied, from_va
 from arena.core.geometry import point_segment_distance
 from arena.core.types import Pose2D, wrap_angle_scalar
 from arena.maps.grid import OccupancyGrid
-from arena.nav.global_planners import GLOBAL_PLANNERS, GlobalPlanner, segment_is_free
+from arena.nav.costmap import (
+    INSCRIBED,
+    Costmap,
+    CostmapParams,
+    GlobalCostmap,
+    LocalCostmap,
+    update_obstacles,
+)
+from arena.nav.global_planners import (
+    GLOBAL_PLANNERS,
+    GlobalPlanner,
+    plan_on_costmap,
+    segment_is_free,
+)
 from arena.nav.intermediate import (
     INTERMEDIATE_PLANNERS,
     IntermediateInput,
@@ -66,7 +105,18 @@ from arena.nav.local_planners import (
     LOCAL_PLANNERS,
     LocalObservation,
     LocalPlanner,
+    infer_kinematics,
     limit_command,
+)
+from arena.nav.recovery import (
+    RECOVERY_BEHAVIORS,
+    OscillationMonitor,
+    RecoveryName,
+    RecoveryRun,
+    mark_points,
+    rear_is_free,
+    sample_path,
+    scan_to_world,
 )
 
 
@@ -79,11 +129,69 @@ class NavStatus(enum.StrEnum):
     """Within the goal tolerances; commands only brake."""
     FAILED = "failed"
     """The initial plan failed; the typed error is in :attr:`NavigationStack.last_error`."""
+    RECOVERING = "recovering"
+    """Running a motion recovery behaviour (rotate, back up) after getting stuck."""
+    STUCK = "stuck"
+    """Stuck and every recovery behaviour has been tried; commands only brake."""
 
 
 def _planner_block(value: Any) -> Any:
     """Normalise the shorthand ``"name"`` to ``{"type": "name"}``."""
     return {"type": value} if isinstance(value, str) else value
+
+
+class CostmapConfig(BaseModel):
+    """Layer parameters of a costmap built by the stack (SI units, ``costmap_2d`` defaults).
+
+    The inscribed radius is not configured here: the stack uses ``robot_radius +
+    inflation_margin``, so cells the robot centre may not enter are those of the inflated map.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+    inflation_radius: float | None = Field(
+        None, ge=0, description="m, extent of the cost decay; None = inscribed radius + 0.5 m"
+    )
+    cost_scaling_factor: float = Field(
+        10.0, ge=0, description="1/m, exponential decay rate of the inflation cost"
+    )
+    obstacle_range: float = Field(2.5, gt=0, description="m, returns closer than this mark")
+    raytrace_range: float = Field(3.0, gt=0, description="m, free space cleared up to this range")
+
+    def params(self, inscribed_radius: float, *, use_semantic: bool) -> CostmapParams:
+        """The :class:`CostmapParams` for a robot of ``inscribed_radius`` (m)."""
+        inflation = (
+            inscribed_radius + 0.5 if self.inflation_radius is None else self.inflation_radius
+        )
+        return CostmapParams(
+            inscribed_radius=inscribed_radius,
+            inflation_radius=max(inflation, inscribed_radius),
+            cost_scaling_factor=self.cost_scaling_factor,
+            obstacle_range=self.obstacle_range,
+            raytrace_range=self.raytrace_range,
+            use_semantic=use_semantic,
+        )
+
+
+class GlobalCostmapConfig(CostmapConfig):
+    """The ``navigation.global_costmap`` block: plan on a layered costmap of the static map."""
+
+    use_scan: bool = Field(
+        False, description="fold every laser scan into the obstacle layer (else only on a block)"
+    )
+    cost_weight: float = Field(
+        3.0, ge=0,
+        description="extra cost per metre at cost 252 for the cost-aware search; 0 = plan with "
+        "the configured global planner on the costmap's lethal (inscribed) cells",
+    )
+
+
+class LocalCostmapConfig(CostmapConfig):
+    """The ``navigation.local_costmap`` block: a rolling window updated every control tick."""
+
+    width: float = Field(6.0, gt=0, description="m, window width")
+    height: float = Field(6.0, gt=0, description="m, window height")
+    use_pedestrians: bool = Field(True, description="add the pedestrian (semantic) layer")
 
 
 class NavigationConfig(BaseModel):
@@ -120,6 +228,33 @@ class NavigationConfig(BaseModel):
     max_path_deviation: float = Field(
         0.5, gt=0, description="m from the path beyond which the stack replans at once"
     )
+    global_costmap: GlobalCostmapConfig | None = Field(
+        None, description="plan on a layered global costmap; None = on the inflated map"
+    )
+    local_costmap: LocalCostmapConfig | None = Field(
+        None, description="rolling local costmap given to the local planner; None = none"
+    )
+    replan_on_blocked: bool = Field(
+        False, description="replan at once (with the scan marked) when the path ahead is blocked"
+    )
+    blocked_lookahead: float = Field(
+        2.0, gt=0, description="m of path ahead of the robot checked for blocking"
+    )
+    oscillation_timeout: float = Field(
+        0.0, ge=0, description="s without oscillation_distance of motion that count as stuck; "
+        "0 disables oscillation detection and recovery"
+    )
+    oscillation_distance: float = Field(
+        0.2, gt=0, description="m the robot must move to count as making progress"
+    )
+    recovery_behaviors: tuple[RecoveryName, ...] = Field(
+        RECOVERY_BEHAVIORS, description="recovery behaviours, in order, when stuck"
+    )
+    back_up_distance: float = Field(0.3, gt=0, description="m reversed by the back_up recovery")
+    back_up_speed: float = Field(0.1, gt=0, description="m/s of the back_up recovery")
+    rotate_speed: float = Field(
+        1.0, gt=0, description="rad/s of the rotate recovery (capped by the robot's limit)"
+    )
 
     # The planner blocks are checked against their registries where the file and key path are
     # known (the experiment loader, :meth:`NavigationStack.from_config`), not here: a pydantic
@@ -131,6 +266,19 @@ class NavigationConfig(BaseModel):
 
 
 _DEFAULTS = NavigationConfig()
+_BLOCKED_REPLAN_INTERVAL = 0.5
+"""s, least time between two replans triggered by a blocked path."""
+_PATH_SAMPLE_STEP = 0.1
+"""m, spacing of the path samples checked for blocking."""
+
+
+def _ped_array(peds: Pedestrians) -> NDArray[np.float64]:
+    """``(n, 4)`` ``[x, y, vx, vy]`` rows (m, m/s, world frame) of ``peds``."""
+    pos = np.asarray(peds.positions, dtype=np.float64).reshape(-1, 2)
+    vel = np.asarray(peds.velocities, dtype=np.float64).reshape(-1, 2)
+    if len(vel) != len(pos):
+        vel = np.zeros_like(pos)
+    return np.hstack([pos, vel])
 
 
 class NavigationStack:
@@ -149,6 +297,21 @@ class NavigationStack:
         intermediate_planner: refines the path between the two; ``None`` = ``bypass``.
         intermediate_period: seconds between intermediate-planner calls; 0 = every tick.
         intermediate_window: radius (m) of the local window given to the intermediate planner.
+        global_costmap: plan on a :class:`~arena.nav.costmap.GlobalCostmap` (``None``: on the
+            inflated occupancy grid, as before).
+        local_costmap: keep a :class:`~arena.nav.costmap.LocalCostmap` rolling window updated
+            every tick (``None``: none).
+        replan_on_blocked: replan at once, with the current scan marked on the planning grid,
+            when a laser return (or a lethal local-costmap cell) blocks the path ahead.
+        blocked_lookahead: length of path ahead checked for blocking (m).
+        oscillation_timeout: seconds without ``oscillation_distance`` of motion before a
+            recovery behaviour runs; 0 disables detection and recovery.
+        oscillation_distance: motion that counts as progress (m).
+        recovery_behaviors: the recovery behaviours in order (see :mod:`arena.nav.recovery`).
+        back_up_distance: distance reversed by ``back_up`` (m).
+        back_up_speed: reversing speed of ``back_up`` (m/s).
+        rotate_speed: turn rate of ``rotate`` (rad/s), capped by the robot's ``omega_max``.
+        scan_range_max: the laser's maximum range (m); readings at it count as no hit.
 
     Raises:
         ConfigError: the local planner cannot drive ``kinematics``, or an argument is invalid.
@@ -171,6 +334,17 @@ class NavigationStack:
         intermediate_planner: IntermediatePlanner | None = None,
         intermediate_period: float = _DEFAULTS.intermediate_period,
         intermediate_window: float = _DEFAULTS.intermediate_window,
+        global_costmap: GlobalCostmapConfig | None = None,
+        local_costmap: LocalCostmapConfig | None = None,
+        replan_on_blocked: bool = _DEFAULTS.replan_on_blocked,
+        blocked_lookahead: float = _DEFAULTS.blocked_lookahead,
+        oscillation_timeout: float = _DEFAULTS.oscillation_timeout,
+        oscillation_distance: float = _DEFAULTS.oscillation_distance,
+        recovery_behaviors: tuple[RecoveryName, ...] = _DEFAULTS.recovery_behaviors,
+        back_up_distance: float = _DEFAULTS.back_up_distance,
+        back_up_speed: float = _DEFAULTS.back_up_speed,
+        rotate_speed: float = _DEFAULTS.rotate_speed,
+        scan_range_max: float = math.inf,
     ) -> None:
         if not robot_radius > 0:
             raise ConfigError(f"robot_radius must be > 0 m, got {robot_radius}")
@@ -184,7 +358,7 @@ class NavigationStack:
                 "intermediate_period must be >= 0 and intermediate_window > 0, got "
                 f"{intermediate_period}, {intermediate_window}"
             )
-        supports = getattr(local_planner, "supports", frozenset())
+        supports: frozenset[str] = getattr(local_planner, "supports", frozenset())
         if kinematics is not None and kinematics not in supports:
             raise ConfigError(
                 f"local planner {type(local_planner).__name__} cannot drive {kinematics!r} robots "
@@ -222,6 +396,45 @@ class NavigationStack:
         self._base_attrs: dict[str, Any] = {}
         self._inter_path: NDArray[np.float64] | None = None
         self._inter_time = -math.inf
+        bad = [
+            name
+            for name in recovery_behaviors
+            if name not in ("clear_costmap", "rotate", "back_up")
+        ]
+        if (
+            bad or not blocked_lookahead > 0 or oscillation_timeout < 0
+            or not (oscillation_distance > 0 and back_up_distance > 0)
+            or not (back_up_speed > 0 and rotate_speed > 0)
+        ):
+            raise ConfigError(
+                "invalid recovery settings: unknown behaviours "
+                f"{bad}, or a non-positive distance, speed or lookahead"
+            )
+        self.global_costmap_config = global_costmap
+        self.local_costmap_config = local_costmap
+        self.global_costmap: GlobalCostmap | None = None
+        """The global costmap (``None`` unless configured); built at :meth:`reset`."""
+        self.local_costmap: LocalCostmap | None = None
+        """The rolling local costmap (``None`` unless configured); updated every tick."""
+        self.replan_on_blocked = bool(replan_on_blocked)
+        self.blocked_lookahead = float(blocked_lookahead)
+        self.oscillation = OscillationMonitor(oscillation_timeout, oscillation_distance)
+        self.recovery_behaviors: tuple[RecoveryName, ...] = tuple(recovery_behaviors)
+        self.back_up_distance = float(back_up_distance)
+        self.back_up_speed = float(back_up_speed)
+        self.rotate_speed = float(rotate_speed)
+        self.scan_range_max = float(scan_range_max)
+        self.blocked_replans = 0
+        """Replans triggered by a blocked path since :meth:`reset`."""
+        self.recoveries: list[RecoveryName] = []
+        """Recovery behaviours run since :meth:`reset`, in order."""
+        self._recovery_index = 0
+        self._recovery: RecoveryRun | None = None
+        self._stuck_xy: NDArray[np.float64] | None = None
+        self._scan_world = np.zeros((0, 2))
+        self._samples = np.zeros((0, 2))
+        self._sample_s = np.zeros(0)
+        self._last_blocked = -math.inf
 
     @classmethod
     def from_config(
@@ -281,6 +494,14 @@ class NavigationStack:
                 max_path_deviation=cfg.max_path_deviation, kinematics=kinematics,
                 intermediate_planner=ip, intermediate_period=cfg.intermediate_period,
                 intermediate_window=cfg.intermediate_window,
+                global_costmap=cfg.global_costmap, local_costmap=cfg.local_costmap,
+                replan_on_blocked=cfg.replan_on_blocked,
+                blocked_lookahead=cfg.blocked_lookahead,
+                oscillation_timeout=cfg.oscillation_timeout,
+                oscillation_distance=cfg.oscillation_distance,
+                recovery_behaviors=cfg.recovery_behaviors,
+                back_up_distance=cfg.back_up_distance, back_up_speed=cfg.back_up_speed,
+                rotate_speed=cfg.rotate_speed,
             )
         except ConfigError as e:
             raise e.located(source=source, prefix=path) from None
@@ -340,6 +561,22 @@ class NavigationStack:
             # Grids are immutable, so episodes on the same map share one inflation (an EDT).
             self.inflated = grid.inflate(self.robot_radius + self.inflation_margin)
             self._nearest_free = None
+            self.global_costmap = None
+        inscribed = self.robot_radius + self.inflation_margin
+        gcfg, lcfg = self.global_costmap_config, self.local_costmap_config
+        if gcfg is not None:
+            if self.global_costmap is None:
+                self.global_costmap = GlobalCostmap(
+                    grid, gcfg.params(inscribed, use_semantic=False)
+                )
+            else:  # same map: forget the previous episode's obstacles
+                self.global_costmap.obstacles.costs[:] = 0
+                self.global_costmap.update()
+        if lcfg is not None:
+            self.local_costmap = LocalCostmap(
+                grid, lcfg.width, lcfg.height,
+                lcfg.params(self.robot_radius, use_semantic=lcfg.use_pedestrians),
+            )
         self.grid = grid
         self.goal = goal
         self.local_planner.reset()
@@ -353,6 +590,14 @@ class NavigationStack:
         self._retry_after = -math.inf
         self.replans = 0
         self.last_error = None
+        self.blocked_replans = 0
+        self.recoveries = []
+        self._recovery_index = 0
+        self._recovery = None
+        self._stuck_xy = None
+        self._scan_world = np.zeros((0, 2))
+        self._last_blocked = -math.inf
+        self.oscillation.reset(start.xy, self._time)
         try:
             self._set_path(self._plan_from(start))
         except PlanningError as e:
@@ -362,16 +607,23 @@ class NavigationStack:
         self.status = NavStatus.ACTIVE
         return self.status
 
-    def replan(self, pose: Pose2D) -> bool:
+    def replan(self, pose: Pose2D, *, mark_scan: bool | None = None) -> bool:
         """Plan again from ``pose``; on failure keep the old path and record :attr:`last_error`.
+
+        Args:
+            pose: the robot's pose (m, rad).
+            mark_scan: plan with the last scan's returns marked on the planning grid (inflated
+                like the map); ``None`` = :attr:`replan_on_blocked`.
 
         Returns:
             Whether a new path was set.
         """
         self._require_reset()
         self.replans += 1
+        if mark_scan is None:
+            mark_scan = self.replan_on_blocked
         try:
-            self._set_path(self._plan_from(pose))
+            self._set_path(self._plan_from(pose, mark_scan=mark_scan))
         except PlanningError as e:
             self.last_error = e
             self._last_plan_time = self._time
@@ -400,10 +652,22 @@ class NavigationStack:
         q = np.asarray(obs.pose, dtype=np.float64).reshape(3)
         v = np.asarray(obs.twist, dtype=np.float64).reshape(3)
         self._time = float(obs.time)
-        if self.status is NavStatus.ACTIVE and self.goal_reached(Pose2D.from_array(q)):
+        running = (NavStatus.ACTIVE, NavStatus.RECOVERING)
+        if self.status in running and self.goal_reached(Pose2D.from_array(q)):
             self.status = NavStatus.GOAL_REACHED
-        if self.status is not NavStatus.ACTIVE:
+            self._recovery = None
+        if self.status not in running:
             return limit_command(np.zeros(3), v, obs.limits, obs.dt)
+
+        self._sense(obs, q, pedestrians)
+        if self.status is NavStatus.RECOVERING:
+            cmd = self._recover(obs, q, v)
+            if cmd is not None:
+                return cmd
+        if self.oscillation.enabled and self._stuck(q):
+            cmd = self._start_recovery(obs, q, v)
+            if cmd is not None:
+                return cmd
 
         due = self.replan_period > 0 and self._time - self._last_plan_time >= self.replan_period
         strayed = (
@@ -412,6 +676,10 @@ class NavigationStack:
         )
         if due or strayed:
             self.replan(Pose2D.from_array(q))
+        elif self._path_blocked(q):
+            self.blocked_replans += 1
+            self._last_blocked = self._time
+            self.replan(Pose2D.from_array(q), mark_scan=True)
 
         path = self._intermediate(obs, q, v, pedestrians)
         local_obs = dataclasses.replace(
@@ -422,6 +690,14 @@ class NavigationStack:
                 if obs.goal_yaw_tolerance is not None
                 else self.goal_tolerance_yaw
             ),
+            pedestrians=(
+                _ped_array(pedestrians)
+                if pedestrians is not None and len(pedestrians) and not np.size(obs.pedestrians)
+                else obs.pedestrians
+            ),
+            costmap=(
+                self.local_costmap.master if self.local_costmap is not None else obs.costmap
+            ),
         )
         return np.asarray(self.local_planner.compute(local_obs), dtype=np.float64).reshape(3)
 
@@ -429,6 +705,160 @@ class NavigationStack:
     def intermediate_path(self) -> NDArray[np.float64]:
         """The path the local planner followed at the last :meth:`step` (m, ``(m, 2)``)."""
         return self._inter_path if self._inter_path is not None else self._path
+
+    # -- sensing, blocking, recovery ------------------------------------------------------------
+    def _sense(
+        self, obs: LocalObservation, q: NDArray[np.float64], pedestrians: Pedestrians | None
+    ) -> None:
+        """Fold this tick's scan into the costmaps and keep its returns (world frame)."""
+        ranges = np.asarray(obs.scan_ranges, dtype=np.float64).reshape(-1)
+        angles = np.asarray(obs.scan_angles, dtype=np.float64).reshape(-1)
+        self._obs = obs
+        self._scan_world = scan_to_world(q, ranges, angles, obs.scan_origin, self.scan_range_max)
+        lcm = self.local_costmap
+        if lcm is not None:
+            peds = pedestrians if pedestrians is not None and len(pedestrians) else None
+            lcm.update(
+                q,
+                scan_ranges=ranges if ranges.size and ranges.shape == angles.shape else None,
+                scan_angles=angles, scan_origin=obs.scan_origin, range_max=self.scan_range_max,
+                ped_positions=None if peds is None else peds.positions,
+                ped_velocities=None if peds is None else peds.velocities,
+            )
+        gcfg = self.global_costmap_config
+        if gcfg is not None and gcfg.use_scan:
+            self._fold_scan_into_global()
+
+    def _fold_scan_into_global(self) -> None:
+        """Mark and clear the last scan in the global obstacle layer (recomposed when planning)."""
+        gcm, obs = self.global_costmap, getattr(self, "_obs", None)
+        if gcm is None or obs is None:
+            return
+        ranges = np.asarray(obs.scan_ranges, dtype=np.float64).reshape(-1)
+        angles = np.asarray(obs.scan_angles, dtype=np.float64).reshape(-1)
+        if ranges.size == 0 or ranges.shape != angles.shape:
+            return
+        q = np.asarray(obs.pose, dtype=np.float64).reshape(3)
+        c, s = math.cos(q[2]), math.sin(q[2])
+        so = np.asarray(obs.scan_origin, dtype=np.float64).reshape(2)
+        sensor = q[:2] + np.array([c * so[0] - s * so[1], s * so[0] + c * so[1]])
+        p = gcm.params
+        update_obstacles(
+            gcm.obstacles, sensor, angles + q[2], ranges, obstacle_range=p.obstacle_range,
+            raytrace_range=p.raytrace_range, range_max=self.scan_range_max,
+        )
+
+    def _path_blocked(self, q: NDArray[np.float64]) -> bool:
+        """Whether the next ``blocked_lookahead`` m of path are blocked (rate-limited).
+
+        Blocked: a lethal or inscribed cell of the local costmap on the path, or a laser return
+        within ``robot_radius`` of it.
+        """
+        if (
+            not self.replan_on_blocked
+            or self._time < self._retry_after
+            or self._time - self._last_blocked < _BLOCKED_REPLAN_INTERVAL
+            or len(self._samples) == 0
+        ):
+            return False
+        i0 = int(np.argmin(np.hypot(*(self._samples - q[:2]).T)))
+        s0 = self._sample_s[i0]
+        within = (self._sample_s >= s0) & (self._sample_s <= s0 + self.blocked_lookahead)
+        ahead = self._samples[within]
+        if self.local_costmap is not None:
+            costs = self.local_costmap.master.cost_at(ahead, off_map=0)
+            if bool(np.any((costs >= INSCRIBED) & (costs != 255))):
+                return True
+        pts = self._scan_world
+        if len(pts) == 0 or len(ahead) == 0:
+            return False
+        d2 = np.sum((ahead[:, None, :] - pts[None, :, :]) ** 2, axis=-1)
+        return bool(np.min(d2) < self.robot_radius**2)
+
+    def _clear_costmaps(self) -> None:
+        """Forget the obstacle layers (recovery ``clear_costmap``)."""
+        if self.global_costmap is not None:
+            self.global_costmap.obstacles.costs[:] = 0
+            self.global_costmap.update()
+        if self.local_costmap is not None:
+            self.local_costmap.obstacles.costs[:] = 0
+
+    def _stuck(self, q: NDArray[np.float64]) -> bool:
+        """Feed the oscillation monitor; re-arm the recoveries once the robot got away."""
+        if self._stuck_xy is not None and float(np.hypot(*(q[:2] - self._stuck_xy))) > (
+            self.oscillation.distance + self.back_up_distance
+        ):
+            self._stuck_xy = None
+            self._recovery_index = 0
+        return self.oscillation.update(q[:2], self._time)
+
+    def _start_recovery(
+        self, obs: LocalObservation, q: NDArray[np.float64], v: NDArray[np.float64]
+    ) -> NDArray[np.float64] | None:
+        """Run the next applicable recovery; ``None`` lets the normal tick go on."""
+        if self._stuck_xy is None:
+            self._stuck_xy = q[:2].copy()
+        lim = obs.limits
+        drive = obs.kinematics or self.kinematics or infer_kinematics(lim)
+        while self._recovery_index < len(self.recovery_behaviors):
+            name = self.recovery_behaviors[self._recovery_index]
+            self._recovery_index += 1
+            if name == "clear_costmap":
+                self.recoveries.append(name)
+                self._clear_costmaps()
+                self.local_planner.reset()
+                self.oscillation.reset(q[:2], self._time)
+                self.replan(Pose2D.from_array(q), mark_scan=False)
+                return None
+            if name == "rotate" and drive != "ackermann" and lim.omega_max > 0:
+                omega = min(self.rotate_speed, float(lim.omega_max))
+                deadline = self._time + 1.5 * 2 * math.pi / omega + 2.0
+            elif name == "back_up" and lim.vx_min < 0 and rear_is_free(
+                q, self._scan_world, self.robot_radius, self.back_up_distance
+            ):
+                speed = min(self.back_up_speed, -float(lim.vx_min))
+                deadline = self._time + 2.0 * self.back_up_distance / speed + 2.0
+            else:
+                continue
+            self.recoveries.append(name)
+            self._recovery = RecoveryRun(name, q[:2].copy(), self._time, float(q[2]), 0.0, deadline)
+            self.status = NavStatus.RECOVERING
+            cmd = self._recover(obs, q, v)
+            if cmd is not None:
+                return cmd
+        if self.status is NavStatus.ACTIVE:
+            self.status = NavStatus.STUCK
+            return limit_command(np.zeros(3), v, lim, obs.dt)
+        return None
+
+    def _recover(
+        self, obs: LocalObservation, q: NDArray[np.float64], v: NDArray[np.float64]
+    ) -> NDArray[np.float64] | None:
+        """One tick of the running motion recovery; ``None`` once it has finished."""
+        run = self._recovery
+        lim = obs.limits
+        if run is None:
+            self.status = NavStatus.ACTIVE
+            return None
+        if run.name == "rotate":
+            run.track(float(q[2]))
+            done = run.turned >= 2 * math.pi - 0.05
+            cmd = np.array([0.0, 0.0, min(self.rotate_speed, float(lim.omega_max))])
+        else:
+            travelled = float(np.hypot(*(q[:2] - run.start_xy)))
+            left = self.back_up_distance - travelled
+            done = left <= 1e-3 or not rear_is_free(
+                q, self._scan_world, self.robot_radius, max(left, 0.0)
+            )
+            cmd = np.array([-min(self.back_up_speed, -float(lim.vx_min)), 0.0, 0.0])
+        if done or self._time >= run.deadline:
+            self._recovery = None
+            self.status = NavStatus.ACTIVE
+            self.local_planner.reset()
+            self.oscillation.reset(q[:2], self._time)
+            self.replan(Pose2D.from_array(q))
+            return None
+        return limit_command(cmd, v, lim, obs.dt)
 
     # -- internals ------------------------------------------------------------------------------
     def _base_speed(self, obs: LocalObservation) -> float:
@@ -503,37 +933,73 @@ class NavigationStack:
         p = np.array(path, dtype=np.float64).reshape(-1, 2)
         p.setflags(write=False)
         self._path = p
+        self._samples, self._sample_s = sample_path(p, _PATH_SAMPLE_STEP)
         self._last_plan_time = self._time
         self._retry_after = -math.inf
 
-    def _plan_from(self, start: Pose2D) -> NDArray[np.float64]:
+    def _planning_grid(self, mark_scan: bool) -> tuple[OccupancyGrid, Costmap | None]:
+        """The occupancy grid to plan on, and the global costmap's master when configured.
+
+        Without a global costmap: the inflated map, with the last scan's returns marked (inflated
+        alike) when ``mark_scan``. With one: its lethal/inscribed cells, after folding the last
+        scan into its obstacle layer when ``mark_scan`` (every tick already with ``use_scan``).
+        """
+        assert self.inflated is not None
+        gcm, gcfg = self.global_costmap, self.global_costmap_config
+        if gcm is not None and gcfg is not None:
+            if mark_scan and not gcfg.use_scan:
+                self._fold_scan_into_global()
+            master = gcm.update()
+            return master.to_occupancy(INSCRIBED), master
+        if mark_scan and len(self._scan_world):
+            radius = self.robot_radius + self.inflation_margin
+            return mark_points(self.inflated, self._scan_world, radius), None
+        return self.inflated, None
+
+    def _plan_on(
+        self, grid: OccupancyGrid, costmap: Costmap | None, start: Pose2D
+    ) -> NDArray[np.float64]:
+        gcfg = self.global_costmap_config
+        if costmap is not None and gcfg is not None and gcfg.cost_weight > 0:
+            return plan_on_costmap(
+                costmap, start, self.goal, cost_weight=gcfg.cost_weight, heuristic_weight=1.0,
+                smooth=True,
+            )
+        return self.global_planner.plan(grid, start, self.goal)
+
+    def _plan_from(self, start: Pose2D, *, mark_scan: bool = False) -> NDArray[np.float64]:
         assert self.inflated is not None
         assert self.grid is not None
+        grid, costmap = self._planning_grid(mark_scan)
         try:
-            return self.global_planner.plan(self.inflated, start, self.goal)
+            return self._plan_on(grid, costmap, start)
         except StartOccupied:
-            free = self._free_cell_near(start)
+            free = self._free_cell_near(grid, start)
             if free is None:
                 raise
         via = Pose2D(float(free[0]), float(free[1]), start.theta)
-        path = self.global_planner.plan(self.inflated, via, self.goal)
+        path = self._plan_on(grid, costmap, via)
         return np.vstack([start.xy[None, :], path])
 
-    def _free_cell_near(self, start: Pose2D) -> NDArray[np.float64] | None:
-        """Centre (m) of the inflated map's free cell nearest to ``start``, if safely reachable."""
-        assert self.inflated is not None
+    def _free_cell_near(
+        self, grid: OccupancyGrid, start: Pose2D
+    ) -> NDArray[np.float64] | None:
+        """Centre (m) of ``grid``'s free cell nearest to ``start``, if safely reachable."""
         assert self.grid is not None
-        cell = self.inflated.world_to_cell(start.xy)
-        blocked = self.inflated.occupied
-        if not bool(self.inflated.in_bounds(cell)) or bool(blocked.all()):
+        cell = grid.world_to_cell(start.xy)
+        blocked = grid.occupied
+        if not bool(grid.in_bounds(cell)) or bool(blocked.all()):
             return None
-        if self._nearest_free is None:
+        if grid is self.inflated and self._nearest_free is not None:
+            idx = self._nearest_free
+        else:
             # One EDT with indices gives every cell's nearest free cell; computed on first need.
             _, idx = ndimage.distance_transform_edt(blocked, return_indices=True)
-            self._nearest_free = idx
+            if grid is self.inflated:
+                self._nearest_free = idx
         r, c = int(cell[0]), int(cell[1])
-        free_cell = self._nearest_free[:, r, c]
-        centre = self.inflated.cell_to_world(free_cell)
+        free_cell = idx[:, r, c]
+        centre = grid.cell_to_world(free_cell)
         if not segment_is_free(self.grid, start.xy, centre):
             return None
         return centre

@@ -268,3 +268,24 @@ def test_path_is_read_only() -> None:
     nav.reset(OccupancyGrid.empty(5.0, 5.0, RES), Pose2D(1, 1), Pose2D(4, 4))
     with pytest.raises(ValueError, match="read-only"):
         nav.path[0, 0] = 0.0
+
+
+def test_status_values_are_stable_strings() -> None:
+    assert [s.value for s in NavStatus] == [
+        "active", "goal_reached", "failed", "recovering", "stuck",
+    ]
+
+
+def test_default_stack_ignores_scans_for_planning() -> None:
+    """Defaults keep today's behaviour: no costmaps, no blocked replans, no recovery."""
+    grid = OccupancyGrid.empty(10.0, 10.0, RES)
+    nav = _stack(replan_period=0.0)
+    nav.reset(grid, Pose2D(1.0, 1.0), Pose2D(8.0, 1.0))
+    wall = grid.with_occupied(np.abs(np.indices(grid.data.shape)[1] * RES - 3.0) < 0.2)
+    pose = np.array([1.0, 1.0, 0.0])
+    for k in range(100):  # not moving for 10 s next to an unmapped wall
+        ranges, angles = _lidar(wall, pose)
+        nav.step(_obs(pose, t=k * DT, ranges=ranges, angles=angles))
+    assert nav.status is NavStatus.ACTIVE
+    assert nav.replans == 0 and nav.blocked_replans == 0 and nav.recoveries == []
+    assert nav.global_costmap is None and nav.local_costmap is None

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import ClassVar, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -17,6 +17,9 @@ from numpy.typing import NDArray
 from arena.core.registry import Registry
 from arena.core.types import Pose2D
 from arena.robots.limits import VelocityLimits
+
+if TYPE_CHECKING:
+    from arena.nav.costmap import Costmap
 
 KINEMATICS: frozenset[str] = frozenset({"diff_drive", "omni", "ackermann", "legged"})
 """Kinematics names a local planner may declare in :attr:`LocalPlanner.supports`."""
@@ -28,6 +31,10 @@ def _empty() -> NDArray[np.float64]:
 
 def _zero2() -> NDArray[np.float64]:
     return np.zeros(2, dtype=np.float64)
+
+
+def _empty_peds() -> NDArray[np.float64]:
+    return np.zeros((0, 4), dtype=np.float64)
 
 
 @dataclass(frozen=True, eq=False)
@@ -53,6 +60,11 @@ class LocalObservation:
         goal_yaw_tolerance: heading error (rad) the navigation stack accepts at the goal, or
             ``None`` when the goal heading does not matter. Planners that can turn the robot on
             the spot align it to the goal's ``theta`` when this is set.
+        pedestrians: ``(n, 4)`` known pedestrians ``[x, y, vx, vy]`` (m, m/s, world frame) that
+            the stack passes on (empty when it has none); human-aware planners use them.
+        costmap: the navigation stack's rolling local costmap (``costmap_2d`` costs, world
+            placement; see :mod:`arena.nav.costmap`) when ``navigation.local_costmap`` is
+            configured, else ``None``. Read-only for planners.
     """
 
     pose: NDArray[np.float64]
@@ -68,6 +80,8 @@ class LocalObservation:
     time: float = 0.0
     kinematics: str | None = None
     goal_yaw_tolerance: float | None = None
+    pedestrians: NDArray[np.float64] = field(default_factory=_empty_peds)
+    costmap: Costmap | None = None
 
     @property
     def goal_pose(self) -> Pose2D:
