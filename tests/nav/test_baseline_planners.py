@@ -1,0 +1,218 @@
+"""Social force and ORCA local planners: limits, goals, obstacles, determinism, cycle time."""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from arena.config import load_config
+from arena.core.types import Pose2D
+from arena.experiment import run_experiment
+from arena.nav.local_planners import (
+    LOCAL_PLANNERS,
+    LocalObservation,
+    OrcaPlanner,
+    SocialForcePlanner,
+)
+from arena.nav.local_planners.orca_planner import orca_velocity
+from arena.robots.kinematics import integrate_twist
+from arena.robots.limits import VelocityLimits
+
+DT = 0.1
+RADIUS = 0.3
+DIFF = VelocityLimits(0.0, 1.0, 0.0, 0.0, 1.5, 1.0, 0.0, 3.0)
+OMNI = VelocityLimits(-0.8, 0.8, -0.6, 0.6, 1.2, 1.0, 1.0, 2.0)
+CAR = VelocityLimits(0.0, 1.5, 0.0, 0.0, 1.5, 1.0, 0.0, 2.0, min_turning_radius=1.2)
+LEGGED = VelocityLimits(-0.3, 0.7, 0.0, 0.0, 1.0, 0.8, 0.0, 2.0)
+DRIVES = {"diff_drive": DIFF, "omni": OMNI, "ackermann": CAR, "legged": LEGGED}
+NAMES = ["social_force", "orca"]
+
+
+def _obs(pose, path, twist=(0.0, 0.0, 0.0), limits=DIFF, kin="diff_drive", ranges=None,
+         angles=None) -> LocalObservation:
+    path = np.asarray(path, dtype=float)
+    return LocalObservation(
+        pose=np.asarray(pose, dtype=float), twist=np.asarray(twist, dtype=float),
+        goal=Pose2D(*path[-1]), path=path, limits=limits, robot_radius=RADIUS, dt=DT,
+        scan_ranges=np.zeros(0) if ranges is None else np.asarray(ranges, dtype=float),
+        scan_angles=np.zeros(0) if angles is None else np.asarray(angles, dtype=float),
+        kinematics=kin,
+    )
+
+
+def _line(x0: float, x1: float, n: int = 50) -> np.ndarray:
+    return np.stack([np.linspace(x0, x1, n), np.zeros(n)], axis=-1)
+
+
+def _step(pose: np.ndarray, cmd: np.ndarray) -> np.ndarray:
+    return integrate_twist(pose[None, :], cmd[None, :], DT)[0]
+
+
+def _wall_scan(pose: np.ndarray, wall_x: float, n: int = 360) -> tuple[np.ndarray, np.ndarray]:
+    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
+    world = angles + pose[2]
+    with np.errstate(divide="ignore"):
+        t = (wall_x - pose[0]) / np.cos(world)
+    return np.where((t > 0) & (t < 8.0), t, np.inf), angles
+
+
+def _post_scan(pose: np.ndarray, centre: np.ndarray, radius: float,
+               n: int = 360) -> tuple[np.ndarray, np.ndarray]:
+    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
+    d = np.stack([np.cos(angles + pose[2]), np.sin(angles + pose[2])], axis=-1)
+    rel = centre - pose[:2]
+    b = d @ rel
+    disc = b * b - (rel @ rel - radius * radius)
+    t = b - np.sqrt(np.maximum(disc, 0.0))
+    return np.where((disc >= 0) & (t > 0), t, np.inf), angles
+
+
+def test_registered_types() -> None:
+    assert isinstance(LOCAL_PLANNERS.build({"type": "social_force"}), SocialForcePlanner)
+    assert isinstance(LOCAL_PLANNERS.build({"type": "orca"}), OrcaPlanner)
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("kin", sorted(DRIVES))
+def test_commands_stay_within_limits(name: str, kin: str) -> None:
+    lim = DRIVES[kin]
+    rng = np.random.default_rng(3)
+    planner = LOCAL_PLANNERS.build({"type": name})
+    for _ in range(30):
+        twist = rng.uniform(lim.lower, lim.upper)
+        if not lim.holonomic:
+            twist[1] = 0.0
+        if kin == "ackermann":
+            twist[0] = abs(twist[0])
+            twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
+        pose = rng.uniform([-1, -1, -3], [1, 1, 3])
+        path = np.vstack([pose[:2], pose[:2] + rng.normal(0, 2, (3, 2)).cumsum(axis=0)])
+        ranges = rng.uniform(0.4, 5.0, 90)
+        angles = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+        cmd = planner.compute(_obs(pose, path, twist, lim, kin, ranges, angles))
+        room = lim.acceleration * DT + 1e-9
+        assert np.all(cmd >= lim.lower - 1e-9) and np.all(cmd <= lim.upper + 1e-9)
+        assert abs(cmd[0] - twist[0]) <= room[0] and abs(cmd[1] - twist[1]) <= room[1]
+        if kin == "ackermann":
+            assert abs(cmd[2]) <= abs(cmd[0]) / lim.min_turning_radius + 1e-9
+        else:
+            assert abs(cmd[2] - twist[2]) <= room[2]
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("kin", ["diff_drive", "omni", "legged"])
+def test_reaches_a_goal_behind_and_aside(name: str, kin: str) -> None:
+    lim = DRIVES[kin]
+    planner = LOCAL_PLANNERS.build({"type": name})
+    path = np.array([[0.0, 0.0], [-1.0, 2.0], [-3.0, 2.5]])
+    pose, twist = np.array([0.0, 0.0, 0.0]), np.zeros(3)
+    for _ in range(400):
+        cmd = planner.compute(_obs(pose, path, twist, lim, kin))
+        pose, twist = _step(pose, cmd), cmd
+    assert np.linalg.norm(pose[:2] - path[-1]) < 0.1
+    assert np.allclose(twist, 0.0, atol=0.3)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_car_reaches_a_goal_with_its_turning_radius(name: str) -> None:
+    planner = LOCAL_PLANNERS.build({"type": name})
+    t = np.linspace(0.0, math.pi, 60)
+    path = np.stack([2.0 * np.sin(t), 2.0 * (1.0 - np.cos(t))], axis=-1)
+    pose, twist = np.zeros(3), np.zeros(3)
+    for _ in range(250):
+        cmd = planner.compute(_obs(pose, path, twist, CAR, "ackermann"))
+        assert abs(cmd[2]) <= abs(cmd[0]) / CAR.min_turning_radius + 1e-9
+        pose, twist = _step(pose, cmd), cmd
+    assert np.linalg.norm(pose[:2] - path[-1]) < 0.5
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_stops_before_a_wall(name: str) -> None:
+    planner = LOCAL_PLANNERS.build({"type": name})
+    path = _line(0.0, 6.0)
+    pose, twist = np.zeros(3), np.array([0.8, 0.0, 0.0])
+    for _ in range(200):
+        ranges, angles = _wall_scan(pose, 3.0)
+        cmd = planner.compute(_obs(pose, path, twist, DIFF, "diff_drive", ranges, angles))
+        pose, twist = _step(pose, cmd), cmd
+        assert 3.0 - pose[0] > RADIUS  # never touches the wall
+    assert abs(twist[0]) < 0.05
+    assert 3.0 - pose[0] - RADIUS < 0.8  # it did not stop far too early
+
+
+@pytest.mark.parametrize("name", NAMES)
+@pytest.mark.parametrize("kin", ["diff_drive", "omni"])
+def test_steers_around_a_post(name: str, kin: str) -> None:
+    lim = DRIVES[kin]
+    planner = LOCAL_PLANNERS.build({"type": name})
+    path = _line(0.0, 5.0)
+    centre, post = np.array([2.5, 0.05]), 0.2
+    pose, twist = np.zeros(3), np.zeros(3)
+    closest = math.inf
+    for _ in range(300):
+        ranges, angles = _post_scan(pose, centre, post)
+        cmd = planner.compute(_obs(pose, path, twist, lim, kin, ranges, angles))
+        pose, twist = _step(pose, cmd), cmd
+        closest = min(closest, float(np.linalg.norm(pose[:2] - centre)) - post - RADIUS)
+    assert closest > 0.0
+    assert np.linalg.norm(pose[:2] - path[-1]) < 0.15
+
+
+def test_social_force_is_pushed_by_pedestrians() -> None:
+    planner = SocialForcePlanner()
+    obs = _obs([0, 0, 0], _line(0, 5), (0.5, 0, 0), OMNI, "omni")
+    free = planner.force(obs, np.array([1.0, 0.0]), 0.8)
+    pushed = planner.force(obs, np.array([1.0, 0.0]), 0.8, np.array([[0.8, 0.3]]))
+    assert pushed[0] < free[0] and pushed[1] < free[1]  # pushed back and to the right
+    assert planner.compute(obs, np.array([[0.8, 0.3]])).shape == (3,)
+
+
+def test_orca_velocity_avoids_a_static_neighbour() -> None:
+    # Heading straight at a point 1 m ahead: ORCA deflects and keeps out of its cone.
+    v = orca_velocity(np.array([0.8, 0.0]), np.array([0.8, 0.0]), np.array([[1.0, 0.0]]),
+                      0.4, 1.0, 2.0, DT)
+    assert abs(v[1]) > 1e-3 or v[0] < 0.8
+    free = orca_velocity(np.zeros(2), np.array([0.5, 0.2]), np.zeros((0, 2)), 0.4, 1.0, 2.0, DT)
+    np.testing.assert_allclose(free, [0.5, 0.2])
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_deterministic_and_reset(name: str) -> None:
+    rng = np.random.default_rng(7)
+    ranges = rng.uniform(0.5, 4.0, 180)
+    angles = np.linspace(-math.pi, math.pi, 180, endpoint=False)
+    obs = _obs([0, 0, 0.3], _line(0, 5), (0.3, 0, 0.1), DIFF, "diff_drive", ranges, angles)
+    a = LOCAL_PLANNERS.build({"type": name}).compute(obs)
+    planner = LOCAL_PLANNERS.build({"type": name})
+    planner.compute(_obs([1, 1, 0], _line(0, 5)))
+    planner.reset()
+    np.testing.assert_array_equal(planner.compute(obs), a)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_compute_time_per_cycle(name: str) -> None:
+    planner = LOCAL_PLANNERS.build({"type": name})
+    angles = np.linspace(-2.356, 2.356, 720)
+    ranges = 2.0 / np.maximum(np.abs(np.cos(angles)), 0.3)
+    obs = _obs([0, 0, 0], _line(0, 5), (0.5, 0, 0), DIFF, "diff_drive", ranges, angles)
+    planner.compute(obs)  # compile / warm up
+    t0 = time.process_time()  # CPU time: the shared test machine may be loaded
+    for _ in range(20):
+        planner.compute(obs)
+    assert (time.process_time() - t0) / 20 < 0.05
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_reaches_goals_in_an_empty_room(name: str, tmp_path: Path) -> None:
+    cfg = load_config(None, [
+        f"navigation.local_planner.type={name}", "map.type=empty", "task.obstacles.static=0",
+        "task.obstacles.dynamic=0", "task.timeout=40", "output.video=false", "episodes=5",
+        "task.robots.min_goal_distance=5",
+    ])
+    _, results = run_experiment(cfg, tmp_path)
+    assert [r.outcome for r in results] == ["success"] * 5
+    assert all(r.collisions == 0 for r in results)
