@@ -168,6 +168,12 @@ class _Problem:
         )
 
 
+_USABLE_STATUS = frozenset(
+    {"Solve_Succeeded", "Solved_To_Acceptable_Level", "Maximum_Iterations_Exceeded"}
+)
+"""ipopt outcomes whose iterate is used (clipped and speed-capped) rather than braking."""
+
+
 @LOCAL_PLANNERS.register("mpc", tags=("optimisation", "casadi"))
 class MPCPlanner:
     """Nonlinear MPC local planner (casadi Opti + ipopt); see the module docstring.
@@ -320,12 +326,20 @@ class MPCPlanner:
         opti.set_value(prob.p_acc0, acc0)
         opti.set_value(prob.p_acc, acc * h)
         opti.set_value(prob.p_rsafe2, r_safe * r_safe)
-        x_init, u_init = self._initial_guess(kind, pose, u_now, prob.nu)
+        x_init, u_init = self._initial_guess(
+            kind, pose, u_now, prob.nu, ref_th=ref_th, v_ref=v_ref, lo=lo, hi=hi, acc=acc * h
+        )
         opti.set_initial(prob.x, x_init)
         opti.set_initial(prob.u, u_init)
         opti.set_initial(prob.s, np.zeros((max(p.obstacles, 1), n)))
         try:
-            sol = opti.solve()
+            # solve_limited: an iterate that ran out of iterations is still used (it is
+            # clipped to the limits and speed-capped by the laser below); only a solver error
+            # or a non-finite result falls back to braking.
+            sol = opti.solve_limited()
+            status = str(opti.stats().get("return_status", ""))
+            if status not in _USABLE_STATUS:
+                raise RuntimeError(status)
             u_opt = np.asarray(sol.value(prob.u), dtype=np.float64).reshape(prob.nu, n)
             x_opt = np.asarray(sol.value(prob.x), dtype=np.float64).reshape(3, n + 1)
         except RuntimeError:
@@ -345,18 +359,44 @@ class MPCPlanner:
         return _finish(cmd, twist, lim, dt, car)
 
     def _initial_guess(
-        self, kind: str, pose: NDArray[np.float64], u_now: NDArray[np.float64], nu: int
+        self,
+        kind: str,
+        pose: NDArray[np.float64],
+        u_now: NDArray[np.float64],
+        nu: int,
+        *,
+        ref_th: NDArray[np.float64],
+        v_ref: float,
+        lo: NDArray[np.float64],
+        hi: NDArray[np.float64],
+        acc: NDArray[np.float64],
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """``(3, N+1)`` states and ``(nu, N)`` controls: the shifted last solution or a rollout."""
+        """``(3, N+1)`` states and ``(nu, N)`` controls: the shifted last solution, or (cold
+        start) a rollout that turns toward the reference heading and speeds up to ``v_ref``
+        within the limits; starting from rest makes ipopt slow on turning starts.
+        """
         n, h = self.params.horizon, self.params.step
-        if self._warm is not None and self._warm[0] == kind:
+        warm = self._warm is not None and self._warm[0] == kind
+        u = np.zeros((nu, n))
+        if warm:
+            assert self._warm is not None
             u_prev = self._warm[2]
             u = np.hstack([u_prev[:, 1:], u_prev[:, -1:]])
-        else:
-            u = np.tile(u_now[:, None], (1, n))
         x = np.zeros((3, n + 1))
         x[:, 0] = pose
+        prev = u_now.copy()
         for i in range(n):
+            if not warm:
+                err = wrap_angle_scalar(float(ref_th[i] - x[2, i]))
+                want = prev.copy()
+                want[0] = v_ref * max(math.cos(err), 0.0)
+                turn = err / max(h, 1e-6)
+                if kind == "ackermann":
+                    want[1] = turn / max(abs(want[0]), 0.1)
+                else:
+                    want[-1] = turn
+                want = np.clip(want, prev - acc, prev + acc)
+                u[:, i] = prev = np.clip(want, lo, hi)
             if nu == 3:
                 vx, vy, w = u[0, i], u[1, i], u[2, i]
             elif kind == "ackermann":
