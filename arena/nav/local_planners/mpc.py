@@ -371,9 +371,11 @@ class MPCPlanner:
         hi: NDArray[np.float64],
         acc: NDArray[np.float64],
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """``(3, N+1)`` states and ``(nu, N)`` controls: the shifted last solution, or (cold
-        start) a rollout that turns toward the reference heading and speeds up to ``v_ref``
-        within the limits; starting from rest makes ipopt slow on turning starts.
+        """``(3, N+1)`` states and ``(nu, N)`` controls for ipopt to start from.
+
+        The shifted last solution, or (cold start) a rollout that turns toward the reference
+        heading and speeds up to ``v_ref`` within the limits: starting from rest makes ipopt
+        slow (out of iterations) when the robot must first turn.
         """
         n, h = self.params.horizon, self.params.step
         warm = self._warm is not None and self._warm[0] == kind
