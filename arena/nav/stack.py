@@ -893,6 +893,10 @@ class NavigationStack:
             max_speed=self._base_speed(obs), robot_radius=self.robot_radius,
             pedestrians=pedestrians if pedestrians is not None else Pedestrians(),
             obstacle_points=points, window=self.intermediate_window, time=self._time,
+            global_costmap=(
+                self.global_costmap.master if self.global_costmap is not None else None
+            ),
+            local_costmap=self.local_costmap.master if self.local_costmap is not None else None,
         )
         out = self.intermediate_planner.plan(inp)
         if out.path is self._path:

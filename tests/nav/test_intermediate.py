@@ -270,3 +270,29 @@ def test_unknown_intermediate_planner_names_the_key():
     assert set(INTERMEDIATE_PLANNERS.names()) >= {
         "bypass", "shortsighted", "aggressive", "polite", "sideways", "meta"
     }
+
+
+@pytest.mark.parametrize("with_costmaps", [False, True])
+def test_stack_hands_its_costmaps_to_the_intermediate_planner(with_costmaps):
+    seen = []
+
+    class Recording:
+        def reset(self) -> None:
+            pass
+
+        def plan(self, inp: IntermediateInput) -> IntermediateOutput:
+            seen.append((inp.global_costmap, inp.local_costmap))
+            return IntermediateOutput(path=inp.path)
+
+    kw = {"global_costmap": {}, "local_costmap": {}} if with_costmaps else {}
+    stack = _stack("bypass", **kw)
+    stack.intermediate_planner = Recording()
+    stack.reset(OccupancyGrid.empty(10, 4, 0.05), Pose2D(1.0, 2.0, 0.0), Pose2D(9.0, 2.0, 0.0))
+    stack.step(_obs((1.0, 2.0, 0.0)))
+    glob, local = seen[-1]
+    if with_costmaps:
+        assert glob is not None and local is not None
+        assert glob.costs.shape == (80, 200)  # the whole 10 x 4 m map at 0.05 m
+        assert local.costs.shape[0] < glob.costs.shape[0] or local.costs.shape[1] < 200
+    else:
+        assert glob is None and local is None

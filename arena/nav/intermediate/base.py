@@ -17,12 +17,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 from numpy.typing import NDArray
 
 from arena.core.registry import Registry
+
+if TYPE_CHECKING:  # the costmap package is optional for intermediate planners
+    from arena.nav.costmap import Costmap
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -77,6 +80,9 @@ class IntermediateInput:
         window: size of the local window (m): the radius around the robot that the local
             planner (costmap) looks at.
         time: simulation time (s).
+        global_costmap, local_costmap: the stack's costmaps (``costmap_2d`` costs) when
+            ``navigation.global_costmap`` / ``navigation.local_costmap`` are configured, else
+            ``None``; planners that use them must cope with ``None``.
     """
 
     pose: FloatArray
@@ -89,6 +95,8 @@ class IntermediateInput:
     obstacle_points: FloatArray = field(default_factory=_empty2)
     window: float = 5.0
     time: float = 0.0
+    global_costmap: Costmap | None = None
+    local_costmap: Costmap | None = None
 
 
 @dataclass(frozen=True, eq=False)
