@@ -55,7 +55,6 @@ from numba import njit
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
-from arena.core.types import wrap_angle_scalar
 from arena.nav.local_planners.base import (
     KINEMATICS,
     LOCAL_PLANNERS,
@@ -63,7 +62,12 @@ from arena.nav.local_planners.base import (
     limit_command,
     stopping_speed,
 )
-from arena.nav.local_planners.path_tracking import PathTracker, to_robot_frame
+from arena.nav.local_planners.path_tracking import (
+    PathTracker,
+    finish_command,
+    goal_command,
+    to_robot_frame,
+)
 from arena.robots.limits import VelocityLimits
 
 
@@ -257,14 +261,7 @@ class DWAPlanner:
         d_end = float(np.hypot(*(path[-1] - pose[:2])))
         car = obs.drive == "ackermann" or lim.min_turning_radius > 0
         if d_end <= p.goal_tolerance:
-            cmd = np.zeros(3)
-            want = obs.goal_yaw_tolerance
-            if want is not None and not car:
-                tol = min(p.goal_yaw_tolerance, want / 2)
-                err = wrap_angle_scalar(obs.goal_pose.theta - float(pose[2]))
-                if abs(err) > tol:
-                    cmd[2] = p.heading_gain * err
-            return self._brake(cmd, twist, lim, dt, car)
+            return goal_command(obs, p.heading_gain, p.goal_yaw_tolerance)
 
         samples = self.samples(obs)
         v_top = min(lim.vx_max, p.max_speed) if p.max_speed is not None else lim.vx_max
@@ -302,7 +299,7 @@ class DWAPlanner:
         lo_speed = float(np.min(speed))
         ok &= speed <= max(v_goal, lo_speed) + 1e-9
         if not np.any(ok):
-            return self._brake(np.zeros(3), twist, lim, dt, car)
+            return finish_command(np.zeros(3), twist, lim, dt, car)
 
         # Path and goal terms in the world frame.
         c, sn = math.cos(pose[2]), math.sin(pose[2])
@@ -350,16 +347,3 @@ class DWAPlanner:
         if car:
             return lim.clip(best)
         return limit_command(best, twist, lim, dt)
-
-    @staticmethod
-    def _brake(
-        cmd: NDArray[np.float64], twist: NDArray[np.float64], lim: VelocityLimits, dt: float,
-        car: bool,
-    ) -> NDArray[np.float64]:
-        """``cmd`` within the acceleration window; car-like robots keep their curvature bound."""
-        out = limit_command(cmd, twist, lim, dt)
-        if car:
-            r = lim.min_turning_radius
-            w_max = abs(out[0]) / r if r > 0 else 0.0
-            out[2] = float(np.clip(out[2], -w_max, w_max))
-        return out

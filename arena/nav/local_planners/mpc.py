@@ -70,11 +70,15 @@ from arena.nav.local_planners.base import (
     KINEMATICS,
     LOCAL_PLANNERS,
     LocalObservation,
-    limit_command,
     stopping_speed,
 )
-from arena.nav.local_planners.path_tracking import PathTracker, cluster_points, free_distance
-from arena.robots.limits import VelocityLimits
+from arena.nav.local_planners.path_tracking import (
+    PathTracker,
+    cluster_points,
+    finish_command,
+    free_distance,
+    goal_command,
+)
 
 _FAR = 1.0e3  # m, where unused obstacle slots are parked (relative to the robot)
 
@@ -267,14 +271,7 @@ class MPCPlanner:
         d_end = float(np.hypot(*(path[-1] - pose[:2])))
         if d_end <= p.goal_tolerance:
             self._warm = None
-            cmd = np.zeros(3)
-            want = obs.goal_yaw_tolerance
-            if want is not None and not car:
-                tol = min(p.goal_yaw_tolerance, want / 2)
-                err = wrap_angle_scalar(obs.goal_pose.theta - float(pose[2]))
-                if abs(err) > tol:
-                    cmd[2] = p.heading_gain * err
-            return _finish(cmd, twist, lim, dt, car)
+            return goal_command(obs, p.heading_gain, p.goal_yaw_tolerance)
 
         prob = self._problem(kind)
         n, h = p.horizon, p.step
@@ -345,18 +342,18 @@ class MPCPlanner:
         except RuntimeError:
             self.failures += 1
             self._warm = None
-            return _finish(np.zeros(3), twist, lim, dt, car)
+            return finish_command(np.zeros(3), twist, lim, dt, car)
         if not (np.all(np.isfinite(u_opt)) and np.all(np.isfinite(x_opt))):
             self.failures += 1
             self._warm = None
-            return _finish(np.zeros(3), twist, lim, dt, car)
+            return finish_command(np.zeros(3), twist, lim, dt, car)
         self._warm = (kind, x_opt, u_opt)
         cmd = np.zeros(3)
         cmd[idx] = u_opt[:, 0]
         if kind == "ackermann":
             cmd[2] = u_opt[0, 0] * u_opt[1, 0]
         cmd = self._safety(cmd, obs, pts, decel)
-        return _finish(cmd, twist, lim, dt, car)
+        return finish_command(cmd, twist, lim, dt, car)
 
     def _initial_guess(
         self,
@@ -430,20 +427,3 @@ class MPCPlanner:
         return cmd
 
 
-def _finish(
-    cmd: NDArray[np.float64], twist: NDArray[np.float64], lim: VelocityLimits, dt: float,
-    car: bool,
-) -> NDArray[np.float64]:
-    """``cmd`` within the acceleration window and box; car-like robots keep the turning radius."""
-    if car:
-        out = limit_command(cmd, twist, lim, dt)
-        out[2] = cmd[2]
-        r = lim.min_turning_radius
-        w_max = min(abs(out[0]) / r, lim.omega_max) if r > 0 else lim.omega_max
-        out[2] = float(np.clip(out[2], -w_max, w_max))
-        out[1] = 0.0
-        return out
-    out = limit_command(cmd, twist, lim, dt)
-    if not lim.holonomic:
-        out[1] = 0.0
-    return out

@@ -44,10 +44,9 @@ from arena.nav.local_planners.base import (
     LocalObservation,
     stopping_speed,
 )
-from arena.nav.local_planners.path_tracking import PathTracker, cluster_points
+from arena.nav.local_planners.path_tracking import PathTracker, cluster_points, goal_command
 from arena.nav.local_planners.social_force import (
     cap_by_returns,
-    goal_command,
     lookahead_target,
     velocity_to_twist,
 )

@@ -14,6 +14,10 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from arena.core.types import wrap_angle_scalar
+from arena.nav.local_planners.base import LocalObservation, limit_command
+from arena.robots.limits import VelocityLimits
+
 
 class PathTracker:
     """Tracks progress along a polyline path; the projection never moves backwards.
@@ -177,3 +181,47 @@ def free_distance(
         return math.inf
     gap = along[ahead] - np.sqrt(np.maximum(radius * radius - lateral[ahead] ** 2, 0.0))
     return float(max(np.min(gap), 0.0))
+
+
+def finish_command(
+    cmd: NDArray[np.float64], twist: NDArray[np.float64], lim: VelocityLimits, dt: float,
+    car: bool,
+) -> NDArray[np.float64]:
+    """``cmd`` (``(3,)`` body twist) inside the acceleration window and the velocity box.
+
+    Car-like robots also keep ``|omega| ≤ min(|vx| / min_turning_radius, omega_max)``;
+    non-holonomic robots get ``vy = 0``. Every local planner's last step.
+    """
+    out = limit_command(cmd, twist, lim, dt)
+    if not lim.holonomic:
+        out[1] = 0.0
+    if car:
+        r = lim.min_turning_radius
+        w_max = min(abs(out[0]) / r, lim.omega_max) if r > 0 else 0.0
+        out[2] = float(np.clip(out[2], -w_max, w_max))
+    return out
+
+
+def goal_command(
+    obs: LocalObservation, heading_gain: float, yaw_tolerance: float
+) -> NDArray[np.float64]:
+    """Braking command at the goal, turning on the spot to the goal heading when asked.
+
+    The stack asks through ``obs.goal_yaw_tolerance``; car-like robots cannot turn on the spot.
+
+    Args:
+        obs: the observation.
+        heading_gain: 1/s, yaw rate per radian of heading error.
+        yaw_tolerance: rad; the planner aligns to ``min(yaw_tolerance, stack tolerance / 2)``.
+    """
+    lim = obs.limits
+    car = obs.drive == "ackermann" or lim.min_turning_radius > 0
+    cmd = np.zeros(3)
+    want = obs.goal_yaw_tolerance
+    if want is not None and not car:
+        tol = min(yaw_tolerance, want / 2)
+        err = wrap_angle_scalar(obs.goal_pose.theta - float(np.asarray(obs.pose)[2]))
+        if abs(err) > tol:
+            cmd[2] = heading_gain * err
+    twist = np.asarray(obs.twist, dtype=np.float64).reshape(3)
+    return finish_command(cmd, twist, lim, float(obs.dt), car)

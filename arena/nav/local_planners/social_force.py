@@ -43,7 +43,6 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
-from arena.core.types import wrap_angle_scalar
 from arena.nav.local_planners.base import (
     KINEMATICS,
     LOCAL_PLANNERS,
@@ -54,29 +53,11 @@ from arena.nav.local_planners.base import (
 from arena.nav.local_planners.path_tracking import (
     PathTracker,
     cluster_points,
+    finish_command,
     free_distance,
+    goal_command,
     to_robot_frame,
 )
-from arena.robots.limits import VelocityLimits
-
-
-def finish_command(
-    cmd: NDArray[np.float64], twist: NDArray[np.float64], lim: VelocityLimits, dt: float,
-    car: bool,
-) -> NDArray[np.float64]:
-    """``cmd`` (``(3,)`` body twist) inside the acceleration window and the velocity box.
-
-    Car-like robots keep ``|omega| ≤ |vx| / min_turning_radius`` instead of the yaw-acceleration
-    bound; non-holonomic robots get ``vy = 0``.
-    """
-    out = limit_command(cmd, twist, lim, dt)
-    if car:
-        r = lim.min_turning_radius
-        w_max = min(abs(out[0]) / r, lim.omega_max) if r > 0 else lim.omega_max
-        out[2] = float(np.clip(cmd[2], -w_max, w_max))
-    if not lim.holonomic:
-        out[1] = 0.0
-    return out
 
 
 def velocity_to_twist(
@@ -138,23 +119,6 @@ def velocity_to_twist(
     v = 0.0 if abs(alpha) > rotate_threshold else speed * math.cos(alpha)
     v = max(v, 0.0)
     return finish_command(np.array([v, 0.0, w]), twist, lim, dt, False)
-
-
-def goal_command(
-    obs: LocalObservation, heading_gain: float, yaw_tolerance: float
-) -> NDArray[np.float64]:
-    """Braking command at the goal, aligning to the goal heading when asked and possible."""
-    lim = obs.limits
-    car = obs.drive == "ackermann" or lim.min_turning_radius > 0
-    cmd = np.zeros(3)
-    want = obs.goal_yaw_tolerance
-    if want is not None and not car:
-        tol = min(yaw_tolerance, want / 2)
-        err = wrap_angle_scalar(obs.goal_pose.theta - float(np.asarray(obs.pose)[2]))
-        if abs(err) > tol:
-            cmd[2] = heading_gain * err
-    twist = np.asarray(obs.twist, dtype=np.float64).reshape(3)
-    return finish_command(cmd, twist, lim, float(obs.dt), car)
 
 
 def lookahead_target(

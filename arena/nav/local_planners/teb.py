@@ -68,10 +68,15 @@ from arena.nav.local_planners.base import (
     KINEMATICS,
     LOCAL_PLANNERS,
     LocalObservation,
-    limit_command,
     stopping_speed,
 )
-from arena.nav.local_planners.path_tracking import PathTracker, cluster_points, free_distance
+from arena.nav.local_planners.path_tracking import (
+    PathTracker,
+    cluster_points,
+    finish_command,
+    free_distance,
+    goal_command,
+)
 from arena.robots.limits import VelocityLimits
 
 FloatArray = NDArray[np.float64]
@@ -580,14 +585,7 @@ class TEBPlanner:
             drive = "diff_drive"
         if d_end <= p.goal_tolerance:
             self.band = None
-            cmd = np.zeros(3)
-            want = obs.goal_yaw_tolerance
-            if want is not None and not car:
-                tol = min(p.goal_yaw_tolerance, want / 2)
-                err = wrap_angle_scalar(obs.goal_pose.theta - float(pose[2]))
-                if abs(err) > tol:
-                    cmd[2] = p.heading_gain * err
-            return self._finish(cmd, twist, lim, dt, car)
+            return goal_command(obs, p.heading_gain, p.goal_yaw_tolerance)
 
         v_top = min(lim.vx_max, p.max_speed) if p.max_speed is not None else lim.vx_max
         v_top = max(v_top, 1e-3)
@@ -598,7 +596,7 @@ class TEBPlanner:
         if final:
             local[-1] = path[-1]
         if np.hypot(*(local[-1] - pose[:2])) < 1e-3:
-            return self._finish(np.zeros(3), twist, lim, dt, car)
+            return finish_command(np.zeros(3), twist, lim, dt, car)
         band = self._initial_band(pose, local, v_top, drive)
         n = len(band.dt)
 
@@ -716,7 +714,7 @@ class TEBPlanner:
                 # back away from it where the robot can, else stay put and turn.
                 back = self._back_off(pts, lim, holo)
                 if back is not None:
-                    return self._finish(back, twist, lim, dt, car)
+                    return finish_command(back, twist, lim, dt, car)
             if not car and not holo and scale < 0.5:
                 # Blocked straight ahead: turn toward where the band goes further on.
                 ahead = np.cumsum(np.hypot(*np.diff(band.poses[:, :2], axis=0).T))
@@ -724,7 +722,7 @@ class TEBPlanner:
                 far = band.poses[j, :2] - pose[:2]
                 err = wrap_angle_scalar(math.atan2(far[1], far[0]) - float(pose[2]))
                 cmd[2] = p.heading_gain * err
-        return self._finish(cmd, twist, lim, dt, car)
+        return finish_command(cmd, twist, lim, dt, car)
 
     @staticmethod
     def _in_contact(pts: FloatArray, radius: float, direction: FloatArray) -> bool:
@@ -749,17 +747,3 @@ class TEBPlanner:
         if lim.vx_min < 0 and away[0] < 0:
             return np.array([max(lim.vx_min, -speed), 0.0, 0.0])
         return None
-
-    @staticmethod
-    def _finish(
-        cmd: FloatArray, twist: FloatArray, lim: VelocityLimits, dt: float, car: bool
-    ) -> FloatArray:
-        """``cmd`` within the acceleration window; car-like robots keep their curvature bound."""
-        out = limit_command(cmd, twist, lim, dt)
-        if not lim.holonomic:
-            out[1] = 0.0
-        if car:
-            r = lim.min_turning_radius
-            w_max = abs(out[0]) / r if r > 0 else 0.0
-            out[2] = float(np.clip(out[2], -w_max, w_max))
-        return out
