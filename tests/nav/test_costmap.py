@@ -201,6 +201,27 @@ def test_semantic_layer_is_higher_in_front_of_walking_pedestrian() -> None:
     assert still.cost_at([3.025, 2.525]) == still.cost_at([2.025, 2.525]) > 0
 
 
+def test_costmaps_read_the_crowds_semantic_layers() -> None:
+    from arena.crowd.semantic import semantic_points
+    from arena.nav.costmap import pedestrians_from_semantic
+    from tests.crowd.test_semantic import crowd
+
+    state = crowd()
+    points = semantic_points(state)
+    pos, vel = pedestrians_from_semantic(points)
+    np.testing.assert_allclose(pos, state.positions)
+    np.testing.assert_allclose(vel, state.velocities, atol=1e-6)  # float32 evidence
+    grid = OccupancyGrid.empty(10.0, 10.0, RES)
+    a, b = GlobalCostmap(grid), GlobalCostmap(grid)
+    via_semantic = a.update(semantic=points).costs
+    via_arrays = b.update(ped_positions=pos, ped_velocities=vel).costs
+    np.testing.assert_array_equal(via_semantic, via_arrays)
+    assert via_semantic.max() == LETHAL  # the people are in the layer
+    local = LocalCostmap(grid, width=4.0, height=4.0)
+    window = local.update([1.0, 1.0, 0.0], semantic=points)
+    assert window.cost_at([0.5, 0.5]) == LETHAL
+
+
 def test_global_costmap_combines_layers_and_plans() -> None:
     grid = OccupancyGrid.empty(8.0, 6.0, RES)
     gc = GlobalCostmap(grid, CostmapParams(inscribed_radius=0.2, inflation_radius=0.6))

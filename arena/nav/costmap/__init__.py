@@ -1,6 +1,11 @@
 """Layered costmaps after ROS ``costmap_2d``: static, obstacle, inflation and pedestrian layers."""
 
-from arena.nav.costmap.costmap import CostmapParams, GlobalCostmap, LocalCostmap
+from arena.nav.costmap.costmap import (
+    CostmapParams,
+    GlobalCostmap,
+    LocalCostmap,
+    pedestrians_from_semantic,
+)
 from arena.nav.costmap.layers import (
     FREE_SPACE,
     INSCRIBED,
@@ -28,6 +33,7 @@ __all__ = [
     "LocalCostmap",
     "inflate",
     "inflation_cost",
+    "pedestrians_from_semantic",
     "social_costs",
     "static_costs",
     "static_window",

@@ -15,11 +15,13 @@ Defaults follow ``costmap_2d`` / Arena's move_base_flex configs, in SI units.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
+from arena.crowd.semantic import SemanticData
 from arena.maps.grid import OccupancyGrid
 from arena.nav.costmap.layers import (
     FREE_SPACE,
@@ -144,6 +146,7 @@ class GlobalCostmap(_Layered):
         range_max: float = math.inf,
         ped_positions: ArrayLike | None = None,
         ped_velocities: ArrayLike | None = None,
+        semantic: Mapping[str, SemanticData] | None = None,
     ) -> Costmap:
         """Fold in one scan and the current pedestrians; return the updated :attr:`master`.
 
@@ -154,7 +157,11 @@ class GlobalCostmap(_Layered):
             range_max: the sensor's maximum range (m); such readings only clear.
             ped_positions: ``(m, 2)`` pedestrian positions (m).
             ped_velocities: ``(m, 2)`` their velocities (m/s).
+            semantic: the crowd's semantic layers (:func:`arena.crowd.semantic.semantic_points`)
+                instead of ``ped_positions`` / ``ped_velocities``.
         """
+        if semantic is not None:
+            ped_positions, ped_velocities = pedestrians_from_semantic(semantic)
         if sensor_xy is not None and beam_angles is not None and ranges is not None:
             update_obstacles(
                 self.obstacles, sensor_xy, beam_angles, ranges,
@@ -163,6 +170,27 @@ class GlobalCostmap(_Layered):
             )
         self._compose(self._static, ped_positions, ped_velocities)
         return self.master
+
+
+def pedestrians_from_semantic(
+    semantic: Mapping[str, SemanticData],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Pedestrian positions and velocities from the crowd's semantic layers.
+
+    Reads the ``pedestrian`` layer's locations and the ``pedestrian_vel_x`` /
+    ``pedestrian_vel_y`` evidence (see :mod:`arena.crowd.semantic`), which list the same people
+    in the same order.
+
+    Returns:
+        ``(m, 2)`` positions (m) and ``(m, 2)`` velocities (m/s), world frame.
+    """
+    people = semantic["pedestrian"]
+    pos = np.asarray(people.locations, dtype=np.float64).reshape(-1, 2)
+    vx = np.asarray(semantic["pedestrian_vel_x"].evidence, dtype=np.float64).reshape(-1)
+    vy = np.asarray(semantic["pedestrian_vel_y"].evidence, dtype=np.float64).reshape(-1)
+    if not len(vx) == len(vy) == len(pos):
+        raise ValueError("semantic layers pedestrian / pedestrian_vel_x / _y differ in length")
+    return pos, np.stack([vx, vy], axis=1)
 
 
 class LocalCostmap(_Layered):
@@ -230,6 +258,7 @@ class LocalCostmap(_Layered):
         range_max: float = math.inf,
         ped_positions: ArrayLike | None = None,
         ped_velocities: ArrayLike | None = None,
+        semantic: Mapping[str, SemanticData] | None = None,
     ) -> Costmap:
         """One tick: follow the robot, fold in the scan and the pedestrians.
 
@@ -241,10 +270,13 @@ class LocalCostmap(_Layered):
             range_max: the sensor's maximum range (m); such readings only clear.
             ped_positions: ``(m, 2)`` pedestrian positions (m), world frame.
             ped_velocities: ``(m, 2)`` their velocities (m/s).
+            semantic: the crowd's semantic layers instead of the two arrays above.
 
         Returns:
             The updated :attr:`master` window.
         """
+        if semantic is not None:
+            ped_positions, ped_velocities = pedestrians_from_semantic(semantic)
         pose = np.asarray(robot_pose, dtype=np.float64).reshape(3)
         self._move_to(pose[:2])
         if scan_ranges is not None and scan_angles is not None:
