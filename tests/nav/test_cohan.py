@@ -15,12 +15,9 @@ from arena.experiment import run_experiment
 from arena.nav.local_planners import LOCAL_PLANNERS, CohanPlanner, LocalObservation
 from arena.nav.local_planners.teb import BandContext
 from arena.robots.kinematics import integrate_twist
-from arena.robots.limits import VelocityLimits
+from tests.nav.planner_kit import DIFF, DT, RADIUS
 
-DT = 0.1
-RADIUS = 0.3
 PED_RADIUS = 0.3
-DIFF = VelocityLimits(0.0, 1.0, 0.0, 0.0, 1.5, 1.0, 0.0, 3.0)
 
 
 def _ped_scan(pose: np.ndarray, ped: np.ndarray, n: int = 360) -> tuple[np.ndarray, np.ndarray]:

@@ -12,66 +12,21 @@ import pytest
 pytest.importorskip("casadi")
 
 from arena.config import load_config
-from arena.core.types import Pose2D
 from arena.experiment import run_experiment
-from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation, MPCPlanner
-from arena.robots.kinematics import integrate_twist
+from arena.nav.local_planners import LOCAL_PLANNERS, MPCPlanner
 from arena.robots.limits import VelocityLimits
-
-DT = 0.1
-RADIUS = 0.3
-DIFF = VelocityLimits(0.0, 1.0, 0.0, 0.0, 1.5, 1.0, 0.0, 3.0)
-OMNI = VelocityLimits(-0.8, 0.8, -0.6, 0.6, 1.2, 1.0, 1.0, 2.0)
-CAR = VelocityLimits(0.0, 1.5, 0.0, 0.0, 1.5, 1.0, 0.0, 2.0, min_turning_radius=1.2)
-LEGGED = VelocityLimits(-0.3, 0.7, 0.0, 0.0, 1.0, 0.8, 0.0, 2.0)
-DRIVES = {"diff_drive": DIFF, "omni": OMNI, "ackermann": CAR, "legged": LEGGED}
+from tests.nav.planner_kit import CAR, DIFF, DRIVES, DT, RADIUS
+from tests.nav.planner_kit import line as _line
+from tests.nav.planner_kit import obs as _obs
+from tests.nav.planner_kit import post_scan as _post_scan
+from tests.nav.planner_kit import step as _step
+from tests.nav.planner_kit import wall_scan as _wall_scan
 
 
 def _mpc(**kw: object) -> MPCPlanner:
     planner = LOCAL_PLANNERS.build({"type": "mpc", **kw})
     assert isinstance(planner, MPCPlanner)
     return planner
-
-
-def _obs(pose, path, twist=(0.0, 0.0, 0.0), limits=DIFF, kin="diff_drive", ranges=None,
-         angles=None) -> LocalObservation:
-    path = np.asarray(path, dtype=float)
-    return LocalObservation(
-        pose=np.asarray(pose, dtype=float), twist=np.asarray(twist, dtype=float),
-        goal=Pose2D(*path[-1]), path=path, limits=limits, robot_radius=RADIUS, dt=DT,
-        scan_ranges=np.zeros(0) if ranges is None else np.asarray(ranges, dtype=float),
-        scan_angles=np.zeros(0) if angles is None else np.asarray(angles, dtype=float),
-        kinematics=kin,
-    )
-
-
-def _line(x0: float, x1: float, n: int = 50) -> np.ndarray:
-    return np.stack([np.linspace(x0, x1, n), np.zeros(n)], axis=-1)
-
-
-def _step(pose: np.ndarray, cmd: np.ndarray) -> np.ndarray:
-    return integrate_twist(pose[None, :], cmd[None, :], DT)[0]
-
-
-def _wall_scan(pose: np.ndarray, wall_x: float, n: int = 360) -> tuple[np.ndarray, np.ndarray]:
-    """Ranges of a wall ``x = wall_x`` (world) seen from ``pose``, 8 m max range."""
-    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
-    world = angles + pose[2]
-    with np.errstate(divide="ignore"):
-        t = (wall_x - pose[0]) / np.cos(world)
-    return np.where((t > 0) & (t < 8.0), t, np.inf), angles
-
-
-def _post_scan(pose: np.ndarray, centre: np.ndarray, radius: float,
-               n: int = 360) -> tuple[np.ndarray, np.ndarray]:
-    """Ranges of a round post (world ``centre``, ``radius``) seen from ``pose``."""
-    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
-    d = np.stack([np.cos(angles + pose[2]), np.sin(angles + pose[2])], axis=-1)
-    rel = centre - pose[:2]
-    b = d @ rel
-    disc = b * b - (rel @ rel - radius * radius)
-    t = b - np.sqrt(np.maximum(disc, 0.0))
-    return np.where((disc >= 0) & (t > 0), t, np.inf), angles
 
 
 def test_missing_casadi_is_a_config_error(monkeypatch: pytest.MonkeyPatch) -> None:

@@ -13,16 +13,10 @@ from arena.config import load_config
 from arena.core.types import Pose2D
 from arena.experiment import run_experiment
 from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation, TEBPlanner
-from arena.robots.kinematics import integrate_twist
 from arena.robots.limits import VelocityLimits
-
-DT = 0.1
-RADIUS = 0.3
-DIFF = VelocityLimits(0.0, 1.0, 0.0, 0.0, 1.5, 1.0, 0.0, 3.0)
-OMNI = VelocityLimits(-0.8, 0.8, -0.6, 0.6, 1.2, 1.0, 1.0, 2.0)
-CAR = VelocityLimits(0.0, 1.5, 0.0, 0.0, 1.5, 1.0, 0.0, 2.0, min_turning_radius=1.2)
-LEGGED = VelocityLimits(-0.3, 0.7, 0.0, 0.0, 1.0, 0.8, 0.0, 2.0)
-DRIVES = {"diff_drive": DIFF, "omni": OMNI, "ackermann": CAR, "legged": LEGGED}
+from tests.nav.planner_kit import CAR, DIFF, DRIVES, DT, RADIUS
+from tests.nav.planner_kit import line as _line
+from tests.nav.planner_kit import step as _step
 
 
 def _teb(**kw: object) -> TEBPlanner:
@@ -42,14 +36,6 @@ def _obs(pose, path, twist=(0.0, 0.0, 0.0), limits=DIFF, kin="diff_drive", range
         kinematics=kin,
         pedestrians=np.zeros((0, 4)) if peds is None else np.asarray(peds, dtype=float),
     )
-
-
-def _line(x0: float, x1: float, n: int = 50) -> np.ndarray:
-    return np.stack([np.linspace(x0, x1, n), np.zeros(n)], axis=-1)
-
-
-def _step(pose: np.ndarray, cmd: np.ndarray) -> np.ndarray:
-    return integrate_twist(pose[None, :], cmd[None, :], DT)[0]
 
 
 def _post_scan(pose: np.ndarray, centre: np.ndarray, r: float, n: int = 360) -> tuple[
