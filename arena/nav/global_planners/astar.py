@@ -321,6 +321,55 @@ def segment_is_free(grid: OccupancyGrid, a: ArrayLike, b: ArrayLike) -> bool:
 
 
 # -- the planner ----------------------------------------------------------------------------------
+
+
+def grid_search(
+    grid: OccupancyGrid,
+    start: Pose2D,
+    goal: Pose2D,
+    *,
+    diagonal: bool = True,
+    heuristic_weight: float = 1.0,
+    clearance_weight: float = 1.0,
+    clearance_scale: float = 0.3,
+    smooth: bool = True,
+) -> NDArray[np.float64]:
+    """A* (``heuristic_weight ≥ 1``) or Dijkstra (``0``) on an inflated grid, then smoothing.
+
+    Shared by :class:`AStarPlanner` and the Dijkstra planner; see their ``Params`` for the
+    arguments and ``plan`` for the returned path and the typed failures.
+    """
+    (sr, sc), (gr, gc) = endpoint_cells(grid, start, goal)
+    blocked = grid.occupied
+    use_clearance = clearance_weight > 0
+    # The distance map costs an EDT; only pay for it when the clearance cost is on. One
+    # vectorised exp per cell is cheaper than one per edge relaxation inside the search.
+    if use_clearance:
+        penalty = clearance_weight * np.exp(-grid.distance / clearance_scale)
+    else:
+        penalty = np.zeros((1, 1))
+    cells, _cost = _astar_cells(
+        blocked, penalty, sr, sc, gr, gc, diagonal, heuristic_weight, use_clearance,
+        grid.resolution,
+    )
+    if len(cells) == 0:
+        raise NoPathFound(
+            f"no path from ({start.x:.3f}, {start.y:.3f}) m to ({goal.x:.3f}, {goal.y:.3f}) m: "
+            f"the goal is not connected to the start through free cells of the inflated map"
+        )
+    # Continuous cell coordinates [x, y] (x along columns): exact endpoints, centres between.
+    # Start and goal in one cell still give two points.
+    pts = np.empty((max(len(cells), 2), 2))
+    pts[1:-1, 0] = cells[1:-1, 1] + 0.5
+    pts[1:-1, 1] = cells[1:-1, 0] + 0.5
+    origin = np.asarray(grid.origin)
+    pts[0] = (start.xy - origin) / grid.resolution
+    pts[-1] = (goal.xy - origin) / grid.resolution
+    if smooth and len(pts) > 2:
+        pts = pts[_shortcut(blocked, penalty, use_clearance, pts)]
+    return pts * grid.resolution + np.asarray(grid.origin)
+
+
 @GLOBAL_PLANNERS.register("astar", tags=("default", "grid"))
 class AStarPlanner:
     """A* over the occupancy grid (numba), with a clearance cost and line-of-sight smoothing.
@@ -370,32 +419,8 @@ class AStarPlanner:
             NoPathFound: no free 4/8-connected route links the two cells.
         """
         p = self.params
-        (sr, sc), (gr, gc) = endpoint_cells(grid, start, goal)
-        blocked = grid.occupied
-        use_clearance = p.clearance_weight > 0
-        # The distance map costs an EDT; only pay for it when the clearance cost is on. One
-        # vectorised exp per cell is cheaper than one per edge relaxation inside the search.
-        if use_clearance:
-            penalty = p.clearance_weight * np.exp(-grid.distance / p.clearance_scale)
-        else:
-            penalty = np.zeros((1, 1))
-        cells, _cost = _astar_cells(
-            blocked, penalty, sr, sc, gr, gc, p.diagonal, p.heuristic_weight, use_clearance,
-            grid.resolution,
+        return grid_search(
+            grid, start, goal, diagonal=p.diagonal, heuristic_weight=p.heuristic_weight,
+            clearance_weight=p.clearance_weight, clearance_scale=p.clearance_scale,
+            smooth=p.smooth,
         )
-        if len(cells) == 0:
-            raise NoPathFound(
-                f"no path from ({start.x:.3f}, {start.y:.3f}) m to ({goal.x:.3f}, {goal.y:.3f}) m: "
-                f"the goal is not connected to the start through free cells of the inflated map"
-            )
-        # Continuous cell coordinates [x, y] (x along columns): exact endpoints, centres between.
-        # Start and goal in one cell still give two points.
-        pts = np.empty((max(len(cells), 2), 2))
-        pts[1:-1, 0] = cells[1:-1, 1] + 0.5
-        pts[1:-1, 1] = cells[1:-1, 0] + 0.5
-        origin = np.asarray(grid.origin)
-        pts[0] = (start.xy - origin) / grid.resolution
-        pts[-1] = (goal.xy - origin) / grid.resolution
-        if p.smooth and len(pts) > 2:
-            pts = pts[_shortcut(blocked, penalty, use_clearance, pts)]
-        return pts * grid.resolution + np.asarray(grid.origin)

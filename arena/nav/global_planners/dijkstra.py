@@ -21,7 +21,7 @@ from arena.core.errors import NoPathFound
 from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
 from arena.nav.costmap.layers import INSCRIBED, MAX_NON_OBSTACLE, NO_INFORMATION, Costmap
-from arena.nav.global_planners.astar import _astar_cells, _shortcut
+from arena.nav.global_planners.astar import _astar_cells, _shortcut, grid_search
 from arena.nav.global_planners.base import GLOBAL_PLANNERS, endpoint_cells
 
 
@@ -63,31 +63,11 @@ class DijkstraPlanner:
             NoPathFound: no free 4/8-connected route links the two cells.
         """
         p = self.params
-        (sr, sc), (gr, gc) = endpoint_cells(grid, start, goal)
-        blocked = grid.occupied
-        use_clearance = p.clearance_weight > 0
-        if use_clearance:
-            penalty = p.clearance_weight * np.exp(-grid.distance / p.clearance_scale)
-        else:
-            penalty = np.zeros((1, 1))
-        cells, _cost = _astar_cells(
-            blocked, penalty, sr, sc, gr, gc, p.diagonal, 0.0, use_clearance, grid.resolution
+        return grid_search(
+            grid, start, goal, diagonal=p.diagonal, heuristic_weight=0.0,
+            clearance_weight=p.clearance_weight, clearance_scale=p.clearance_scale,
+            smooth=p.smooth,
         )
-        if len(cells) == 0:
-            raise NoPathFound(
-                f"no path from ({start.x:.3f}, {start.y:.3f}) m to ({goal.x:.3f}, {goal.y:.3f}) m: "
-                f"the goal is not connected to the start through free cells of the inflated map"
-            )
-        pts = np.empty((max(len(cells), 2), 2))
-        pts[1:-1, 0] = cells[1:-1, 1] + 0.5
-        pts[1:-1, 1] = cells[1:-1, 0] + 0.5
-        origin = np.asarray(grid.origin)
-        pts[0] = (start.xy - origin) / grid.resolution
-        pts[-1] = (goal.xy - origin) / grid.resolution
-        if p.smooth and len(pts) > 2:
-            pts = pts[_shortcut(blocked, penalty, use_clearance, pts)]
-        out: NDArray[np.float64] = pts * grid.resolution + origin
-        return out
 
 
 def plan_on_costmap(
