@@ -153,10 +153,10 @@ def test_deterministic_and_fast() -> None:
     )
     planner = LOCAL_PLANNERS.build({"type": "cohan"})
     first = planner.compute(obs)
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     for _ in range(10):
         planner.compute(obs)
-    assert (time.perf_counter() - t0) / 10 < 0.05
+    assert (time.process_time() - t0) / 10 < 0.05
     planner.reset()
     np.testing.assert_array_equal(planner.compute(obs), first)
     np.testing.assert_array_equal(LOCAL_PLANNERS.build({"type": "cohan"}).compute(obs), first)

@@ -181,10 +181,10 @@ def test_compute_time_per_cycle() -> None:
     lim = VelocityLimits(-2.0, 2.0, 0.0, 0.0, 4.0, 20.0, 0.0, 25.0)
     obs = _obs([0, 0, 0], _line(0, 5), (0.5, 0, 0), lim, "diff_drive", ranges, angles)
     planner.compute(obs)
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     for _ in range(20):
         planner.compute(obs)
-    assert (time.perf_counter() - t0) / 20 < 0.05
+    assert (time.process_time() - t0) / 20 < 0.05
 
 
 def test_jackal_reaches_the_goal_in_an_empty_room(tmp_path: Path) -> None:
