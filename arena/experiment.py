@@ -11,6 +11,7 @@ Output layout (``output.dir``)::
     episode_000/
         trajectory.csv      robot state per step
         agents.csv          pedestrian state per step
+        episode.parquet     the EpisodeRecord (arena.eval.io.load_record)
         episode.json        start, goal, outcome, figures
         video.mp4           top-down video (first ``output.video_episodes`` episodes)
         final.png           the last frame
@@ -23,7 +24,7 @@ import json
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field, fields
 from datetime import datetime
 from pathlib import Path
 from typing import Any
@@ -37,6 +38,9 @@ from arena.core.errors import ArenaError, PlanningError
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
+from arena.eval.io import save_record
+from arena.eval.record import EpisodeMeta, EpisodeRecord
+from arena.eval.recorder import Recorder
 from arena.maps.raster import polygon_mask
 from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
@@ -74,6 +78,15 @@ class EpisodeResult:
     control_ms_p95: float = 0.0
     control_ms_max: float = 0.0
     files: dict[str, str] = field(default_factory=dict)
+    #: The full step-by-step record (not part of :meth:`summary`, episode.json or summary.csv;
+    #: on disk it is ``files["record"]``, ``episode.parquet``).
+    record: EpisodeRecord | None = field(default=None, repr=False, compare=False)
+
+    def summary(self) -> dict[str, Any]:
+        """The figures as plain data (every field but ``record``), as in episode.json."""
+        return {
+            f.name: getattr(self, f.name) for f in fields(self) if f.name != "record"
+        }
 
 
 def make_episode(
@@ -188,6 +201,10 @@ class EpisodeRecorder:
         return {"trajectory": str(traj), "agents": str(agents)}
 
 
+def _fmt_pose(p: Pose2D) -> str:
+    return f"[{p.x:.3f}, {p.y:.3f}, {p.theta:.3f}]"
+
+
 def _write_csv(
     path: Path, header: tuple[str, ...], rows: np.ndarray, int_cols: tuple[int, ...]
 ) -> None:
@@ -248,8 +265,10 @@ def run_episode(
     goal = spawn.goal
 
     recorder = EpisodeRecorder()
+    rec = Recorder()
     control_s: list[float] = []  # wall time of each navigation-stack call (global+inter+local)
     recorder.record(state)
+    rec.record(state)
     states = [state] if video else []
     outcome, error = Outcome.TIMEOUT, ""
     collisions, touching = 0, False
@@ -259,7 +278,10 @@ def run_episode(
         stack.reset(planning_grid(episode), spawn.start, goal)
         while True:
             update = runtime.update(state.time, state.robots.poses, state.agents.positions)
+            if 0 in update.reached:
+                rec.event(state.time, "goal_reached", "robot 0")
             if update.reset:
+                rec.event(state.time, "reset", "forced reset")
                 outcome = Outcome.ABORTED
                 break
             if update.done:
@@ -270,8 +292,10 @@ def run_episode(
                 if i == 0:
                     jumps.append(len(recorder.robot_rows))
                     touching = bool(state.collisions.any[0])
+                    rec.event(state.time, "teleport", f"robot 0 to {_fmt_pose(target)}")
             if 0 in update.goals:
                 goal = update.goals[0]
+                rec.event(state.time, "new_goal", f"robot 0 to {_fmt_pose(goal)}")
             if 0 in update.goals or 0 in update.teleports:
                 stack.reset(
                     planning_grid(episode), Pose2D.from_array(state.robots.poses[0]), goal,
@@ -314,6 +338,7 @@ def run_episode(
                     time.sleep(ahead)
             state = backend.step(cmd[None, :], dt)
             recorder.record(state)
+            rec.record(state)
             if video:
                 states.append(state)
             hit = bool(state.collisions.any[0])
@@ -324,6 +349,25 @@ def run_episode(
     except ArenaError as e:
         outcome, error = Outcome.ERROR, f"{type(e).__name__}: {e}"
 
+    rec.event(state.time, "outcome", outcome.value)
+    record = rec.finish(
+        EpisodeMeta(
+            episode=idx,
+            seed=episode.seed,
+            stage=episode.label,
+            map_name=episode.map_name,
+            robot=robot.name,
+            robot_radius=float(robot.radius),
+            start=spawn.start.as_array(),
+            goal=goal.as_array(),
+            goal_radius=float(episode.goal_radius),
+            goal_tolerance_angle=episode.goal_tolerance_angle,
+            time_limit=float(episode.time_limit),
+            dt=float(dt),
+            outcome=outcome.value,
+            config=cfg.model_dump(mode="json"),
+        )
+    )
     poses = recorder.poses
     steps = np.hypot(*np.diff(poses[:, :2], axis=0).T) if len(poses) > 1 else np.zeros(0)
     for row in jumps:  # a teleport is no distance driven
@@ -349,6 +393,7 @@ def run_episode(
         error=error,
         goals_reached=runtime.goals_reached[0],
         teleports=runtime.teleports[0],
+        record=record,
     )
     if control_s:
         ms = 1e3 * np.array(control_s)
@@ -358,12 +403,13 @@ def run_episode(
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)
         result.files.update(recorder.write(out_dir))
+        result.files["record"] = str(save_record(record, out_dir / "episode.parquet"))
         if video and states:
             result.files.update(
                 _write_video(cfg, backend, states, stack.path, goal, out_dir, outcome, episode)
             )
         result.wall_time = time.perf_counter() - t0
-        (out_dir / "episode.json").write_text(json.dumps(asdict(result), indent=2))
+        (out_dir / "episode.json").write_text(json.dumps(result.summary(), indent=2))
     result.wall_time = time.perf_counter() - t0
     return result
 
@@ -484,5 +530,5 @@ def _write_summary(path: Path, results: list[EpisodeResult]) -> None:
         w = csv.writer(f)
         w.writerow(cols)
         for r in results:
-            d = asdict(r)
+            d = r.summary()
             w.writerow([f"{d[c]:.4f}" if isinstance(d[c], float) else d[c] for c in cols])

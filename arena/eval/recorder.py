@@ -1,0 +1,160 @@
+"""Collect every simulation step of one episode into an :class:`~arena.eval.record.EpisodeRecord`.
+
+The :class:`Recorder` keeps robot 0 (one row per recorded state) and every pedestrian (whole
+arrays appended per step, long format) in growing numpy buffers: capacity doubles when full, so
+recording is amortised O(1) per step with no per-agent Python loop. Events (goal reached, new
+goal, teleport, outcome) are kept as ``(time s, kind, detail)`` tuples.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from arena.eval.record import EpisodeMeta, EpisodeRecord
+from arena.sim.state import SimState
+
+FloatArray = NDArray[np.float64]
+
+# Robot buffer columns: time, x, y, theta, vx, vy, omega, cmd_vx, cmd_vy, cmd_omega, min_range.
+_ROBOT_F = 11
+# Pedestrian float columns: x, y, vx, vy, heading, radius.
+_PED_F = 6
+# Pedestrian int columns: row, id, kind, state.
+_PED_I = 4
+
+
+def _grow(buf: np.ndarray, need: int) -> np.ndarray:
+    """``buf`` with at least ``need`` rows (capacity doubled), old rows kept."""
+    if need <= buf.shape[0]:
+        return buf
+    cap = max(need, 2 * buf.shape[0], 16)
+    out = np.empty((cap, *buf.shape[1:]), dtype=buf.dtype)
+    out[: buf.shape[0]] = buf
+    return out
+
+
+class Recorder:
+    """Records robot 0 and all pedestrians at every simulation step.
+
+    Call :meth:`record` with the state after ``reset`` and after every ``step`` (and, if wanted,
+    after a teleport), :meth:`event` for discrete happenings, and :meth:`finish` once at the end.
+
+    Args:
+        keep_scans: also keep robot 0's laser scan of every row (``scans``: ``(T, beams)`` m),
+            e.g. for :func:`arena.eval.io.export_arena_csv`'s ``scan.csv``.
+        capacity: initial number of robot rows reserved.
+    """
+
+    def __init__(self, *, keep_scans: bool = False, capacity: int = 256) -> None:
+        self.keep_scans = keep_scans
+        self._n = 0
+        self._k = 0
+        self._robot = np.empty((capacity, _ROBOT_F), dtype=np.float64)
+        self._coll = np.empty((capacity, 4), dtype=np.bool_)  # wall, obstacle, ped, robot
+        self._ped_f = np.empty((capacity * 4, _PED_F), dtype=np.float64)
+        self._ped_i = np.empty((capacity * 4, _PED_I), dtype=np.int64)
+        self._scans: np.ndarray | None = None
+        self.events: list[tuple[float, str, str]] = []
+
+    def __len__(self) -> int:
+        """Number of robot rows recorded so far."""
+        return self._n
+
+    def record(self, state: SimState, command: FloatArray | None = None) -> None:
+        """Append robot 0 and every pedestrian of ``state``.
+
+        Args:
+            state: the snapshot.
+            command: ``(3,)`` ``[vx m/s, vy m/s, omega rad/s]`` applied during the step that led
+                to ``state``; default ``state.robots.commands[0]`` (what the backend received).
+        """
+        r = state.robots
+        n = self._n
+        self._robot = _grow(self._robot, n + 1)
+        self._coll = _grow(self._coll, n + 1)
+        scan = r.scans[0]
+        min_range = float(scan.min()) if scan.size else math.inf
+        cmd = r.commands[0] if command is None else np.asarray(command, dtype=np.float64)
+        row = self._robot[n]
+        row[0] = state.time
+        row[1:4] = r.poses[0]
+        row[4:7] = r.twists[0]
+        row[7:10] = cmd
+        row[10] = min_range
+        c = state.collisions
+        self._coll[n] = (
+            bool(c.wall[0]), c.obstacle[0] >= 0, c.agent[0] >= 0, c.robot[0] >= 0
+        )
+        if self.keep_scans:
+            if self._scans is None:
+                self._scans = np.empty((self._robot.shape[0], scan.size), dtype=np.float64)
+            self._scans = _grow(self._scans, n + 1)
+            self._scans[n] = scan
+        a = state.agents
+        m = len(a)
+        if m:
+            k = self._k
+            self._ped_f = _grow(self._ped_f, k + m)
+            self._ped_i = _grow(self._ped_i, k + m)
+            f = self._ped_f[k : k + m]
+            f[:, 0:2] = a.positions
+            f[:, 2:4] = a.velocities
+            f[:, 4] = a.headings
+            f[:, 5] = a.radii
+            i = self._ped_i[k : k + m]
+            i[:, 0] = n
+            i[:, 1] = a.ids
+            i[:, 2] = a.kinds
+            i[:, 3] = a.states
+            self._k = k + m
+        self._n = n + 1
+
+    def event(self, time: float, kind: str, detail: str = "") -> None:
+        """Note a discrete event at ``time`` (s).
+
+        Kinds used by :func:`arena.experiment.run_episode`: ``goal_reached``, ``new_goal``,
+        ``teleport``, ``reset``, ``outcome`` (detail: the outcome value).
+        """
+        self.events.append((float(time), kind, detail))
+
+    @property
+    def poses(self) -> FloatArray:
+        """``(T, 3)`` robot poses recorded so far (a copy)."""
+        return self._robot[: self._n, 1:4].copy()
+
+    @property
+    def scans(self) -> FloatArray | None:
+        """``(T, beams)`` robot 0's laser ranges (m), or ``None`` unless ``keep_scans``."""
+        return None if self._scans is None else self._scans[: self._n].copy()
+
+    def finish(self, meta: EpisodeMeta) -> EpisodeRecord:
+        """The record of everything recorded so far (arrays are copies)."""
+        n, k = self._n, self._k
+        rb = self._robot[:n]
+        co = self._coll[:n]
+        pf = self._ped_f[:k]
+        pi = self._ped_i[:k]
+        return EpisodeRecord(
+            meta=meta,
+            time=rb[:, 0].copy(),
+            pose=rb[:, 1:4].copy(),
+            velocity=rb[:, 4:7].copy(),
+            command=rb[:, 7:10].copy(),
+            min_range=rb[:, 10].copy(),
+            collision_wall=co[:, 0].copy(),
+            collision_obstacle=co[:, 1].copy(),
+            collision_pedestrian=co[:, 2].copy(),
+            collision_robot=co[:, 3].copy(),
+            ped_row=pi[:, 0].copy(),
+            ped_id=pi[:, 1].copy(),
+            ped_kind=pi[:, 2].copy(),
+            ped_state=pi[:, 3].copy(),
+            ped_position=pf[:, 0:2].copy(),
+            ped_velocity=pf[:, 2:4].copy(),
+            ped_heading=pf[:, 4].copy(),
+            ped_radius=pf[:, 5].copy(),
+            events=list(self.events),
+        )
