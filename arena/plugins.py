@@ -6,6 +6,7 @@ Third-party plugins arrive through entry points and are loaded by each registry 
 from __future__ import annotations
 
 import arena.crowd
+import arena.eval.metrics
 import arena.maps.generators
 import arena.maps.sources
 import arena.nav

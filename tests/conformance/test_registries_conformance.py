@@ -27,6 +27,7 @@ COVERED = {
     "intermediate planner": "tests/conformance/test_intermediate_conformance.py",
     "robot": "tests/robots/test_presets.py",
     "map generator": "here",
+    "metric": "tests/conformance/test_metrics_conformance.py",
 }
 
 
