@@ -368,6 +368,89 @@ def tasks_preview(
                       f"{len(contestants) * n} runs: {names}")
 
 
+@app.command()
+def bench(
+    suite: Annotated[str, typer.Argument(help="packaged suite name (paper, quick) or YAML path")],
+    contest: Annotated[
+        str | None,
+        typer.Option(help="packaged contest name or YAML path [default: basic; resume: the run's]"),
+    ] = None,
+    workers: Annotated[int, typer.Option("--workers", "-j", help="worker processes")] = 1,
+    resume: Annotated[
+        Path | None, typer.Option("--resume", help="resume the run in this folder")
+    ] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="run folder")] = None,
+    scale: Annotated[
+        float | None,
+        typer.Option(help="scale_episodes: factor on every stage [default: 1; resume: the run's]"),
+    ] = None,
+    seed: Annotated[
+        int | None, typer.Option(help="run seed [default: 0; resume: the run's]")
+    ] = None,
+    progress: Annotated[
+        bool, typer.Option("--progress/--no-progress", help="show a progress bar")
+    ] = True,
+) -> None:
+    """Benchmark: every contestant on every episode of a suite; resumable, parallel.
+
+    Results land in the run folder (``episodes/<contestant>/<stage>/<episode>.parquet|json``,
+    ``run.json``); a killed run continues with ``--resume RUN_DIR``.
+    """
+    from datetime import datetime
+
+    from arena.config.schema import ExperimentConfig
+    from arena.eval.runner import run_benchmark
+    from arena.eval.store import load_results, read_manifest, summarize
+
+    if resume is not None:
+        manifest = read_manifest(resume)
+        contest = contest if contest is not None else str(manifest.get("contest", "basic"))
+        seed = seed if seed is not None else int(manifest.get("seed", 0))
+        scale = scale if scale is not None else float(manifest.get("scale", 1.0))
+    contest = contest if contest is not None else "basic"
+    seed = seed if seed is not None else 0
+    scale = scale if scale is not None else 1.0
+    if resume is not None and out is not None and resume.resolve() != out.resolve():
+        raise ArenaError("give either --resume RUN_DIR or -o RUN_DIR, not two different folders")
+    run_dir = resume or out
+    if run_dir is None:
+        name = Path(contest).stem
+        run_dir = Path("runs") / f"bench_{name}_{datetime.now().strftime('%y-%m-%d_%H-%M-%S')}"
+    run = run_benchmark(
+        suite, contest, run_dir, base_cfg=ExperimentConfig(seed=seed), workers=workers,
+        resume=resume is not None, scale=scale, progress=progress,
+    )
+    table = Table(title=f"arena bench · {suite} · {contest} · seed {seed}")
+    for col in ("contestant", "stage", "episodes", "success", "collisions", "time (s)", "errors"):
+        table.add_column(col, justify="left" if col in ("contestant", "stage") else "right")
+    for row in summarize(load_results(run)):
+        table.add_row(
+            row["contestant"], row["stage"], str(row["episodes"]),
+            f"{100 * row['success_rate']:.0f} %", f"{row['collisions']:.2f}",
+            f"{row['time']:.1f}", str(row["errors"]),
+        )
+    console.print(table)
+    console.print(f"run folder: {run}")
+
+
+@app.command()
+def report(
+    run: Annotated[Path, typer.Argument(help="a benchmark run folder (from arena bench)")],
+    out: Annotated[
+        Path | None, typer.Option("-o", "--out", help="output folder (default RUN/report)")
+    ] = None,
+) -> None:
+    """Write one self-contained HTML report and CSV/LaTeX tables for a benchmark run."""
+    from arena.core.errors import ConfigError
+    from arena.eval.report import main as write_run_report
+
+    if not (run / "run.json").is_file():
+        raise ConfigError(f"{run}: not a benchmark run folder (no run.json); run arena bench")
+    paths = write_run_report(run, out)
+    for kind in ("html", "csv", "tex"):
+        console.print(f"{kind + ':':6} {paths[kind]}")
+
+
 def main() -> None:
     """Console-script entry point: run the app, print user errors as one line."""
     try:

@@ -1,0 +1,344 @@
+"""Run a benchmark: every contestant on every episode of every stage of a suite.
+
+A job is one ``(contestant, stage, episode)``. Its episode is drawn by the stage's
+:class:`~arena.tasks.generator.TaskGenerator`, a pure function of (config, seed, index), so a job
+gives the same result in any process and in any order. Workers only compute; the parent process
+commits each finished job to the run's :mod:`results store <arena.eval.store>`, one file pair per
+job, so the results do not depend on the number of workers, and a killed run resumes where it
+stopped (``resume=True`` skips the committed jobs).
+
+Metrics named like a figure of :class:`~arena.experiment.EpisodeResult` (``path_length``,
+``collisions``) are stored once, as the figure (``collisions`` an int; ``path_length`` without
+teleport jumps); they agree with the metric on episodes without teleports.
+
+An episode whose planner raises, returns NaN or otherwise fails ends as ``error`` with the
+message in ``error``; the run goes on.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+from arena.config.schema import ExperimentConfig
+from arena.core.errors import ArenaError
+from arena.eval.record import EpisodeRecord
+from arena.eval.store import (
+    MANIFEST,
+    check_manifest,
+    commit_episode,
+    completed,
+    load_results,
+    write_manifest,
+)
+from arena.tasks.suite import ContestFile, Suite, contestant_config, load_contest, load_suite
+
+#: ``progress`` callback: ``(done, total, row)`` after each committed job.
+ProgressFn = Callable[[int, int, dict[str, Any]], None]
+
+
+@dataclass(frozen=True)
+class Job:
+    """One episode to run: plain data, picklable for any worker process.
+
+    Attributes:
+        contestant: contestant name.
+        local_planner: local planner name.
+        inter_planner: intermediate planner name.
+        stage: stage name.
+        episode: episode index local to the stage.
+        config: the stage's experiment config for this contestant (``model_dump(mode="json")``).
+    """
+
+    contestant: str
+    local_planner: str
+    inter_planner: str
+    stage: str
+    episode: int
+    config: dict[str, Any]
+
+    @property
+    def key(self) -> tuple[str, str, int]:
+        """``(contestant, stage, episode)``, as in :func:`arena.eval.store.completed`."""
+        return (self.contestant, self.stage, self.episode)
+
+
+def plan_jobs(suite: Suite, contest: ContestFile, base_cfg: ExperimentConfig,
+              *, contest_source: str | None = None) -> list[Job]:
+    """Every job of a run: contestants × stages × episodes, in that order.
+
+    Raises:
+        ConfigError: an unknown planner (naming the contest file and contestant) or a bad stage.
+    """
+    from arena.nav.intermediate.base import INTERMEDIATE_PLANNERS
+
+    jobs = []
+    stages = suite.stage_experiments(base_cfg)
+    for ci, c in enumerate(contest.contestants):
+        try:
+            INTERMEDIATE_PLANNERS.entry(c.inter_planner)
+        except ArenaError as e:
+            raise ArenaError(
+                f"{contest_source or 'contest'}: contestants[{ci}].inter_planner: {e}"
+            ) from None
+        for st, stage_cfg in stages:
+            cfg = contestant_config(stage_cfg, c, source=contest_source, index=ci)
+            data = cfg.model_dump(mode="json")
+            data["name"] = stage_cfg.name
+            data["navigation"]["intermediate_planner"] = {"type": c.inter_planner}
+            cfg = ExperimentConfig.model_validate(data)
+            dumped = cfg.model_dump(mode="json")
+            for k in range(stage_cfg.episodes):
+                jobs.append(Job(c.name, c.local_planner, c.inter_planner, st.name, k, dumped))
+    return jobs
+
+
+@lru_cache(maxsize=8)
+def _generator(config_json: str) -> Any:
+    import json
+
+    from arena.robots.presets import load_robot
+    from arena.tasks.generator import TaskGenerator
+
+    cfg = ExperimentConfig.model_validate(json.loads(config_json))
+    return cfg, TaskGenerator.from_config(cfg, [load_robot(cfg.robot)])
+
+
+def _nan_metrics() -> dict[str, float]:
+    from arena.eval.metrics import METRICS
+
+    return {n: math.nan for n in METRICS.names()}
+
+
+def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
+    """Run one job; return its results row (ids, outcome, metrics, figures) and its record.
+
+    Never raises for a failing episode: any exception becomes outcome ``error`` with
+    ``"<ExceptionType>: message"`` in ``error`` (and NaN metrics when no record was made).
+    """
+    import json
+
+    import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
+    from arena.eval.metrics import compute_metrics
+    from arena.experiment import run_episode
+    from arena.sim.backend import BACKENDS
+
+    t0 = time.perf_counter()
+    row: dict[str, Any] = {
+        "contestant": job.contestant,
+        "local_planner": job.local_planner,
+        "inter_planner": job.inter_planner,
+        "stage": job.stage,
+        "episode": job.episode,
+        "seed": None,
+        "map": "",
+        "robot": str(job.config.get("robot", "")),
+        "outcome": "error",
+        "time": math.nan,
+        "path_length": math.nan,
+        "collisions": 0,
+        "wall_time": 0.0,
+        "error": "",
+    }
+    record = None
+    metrics = _nan_metrics()
+    try:
+        cfg, gen = _generator(json.dumps(job.config, sort_keys=True))
+        episode = gen.episode(job.episode)
+        row.update(seed=int(episode.seed), map=episode.map_name,
+                   robot=episode.robots[0].model.name)
+        backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
+        res = run_episode(cfg, episode, backend, None, runtime=gen.runtime(episode))
+        row.update(outcome=res.outcome, time=float(res.time), path_length=res.path_length,
+                   collisions=int(res.collisions), error=res.error)
+        record = res.record
+        if record is not None:
+            try:
+                metrics.update(compute_metrics(record))
+            except Exception as e:  # a metric bug must not lose the episode
+                row["error"] = (row["error"] + "; " if row["error"] else "") + (
+                    f"metrics: {type(e).__name__}: {e}"
+                )
+    except Exception as e:
+        row["outcome"] = "error"
+        row["error"] = f"{type(e).__name__}: {e}"
+        tb = traceback.extract_tb(e.__traceback__)
+        if tb:
+            row["error"] += f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})"
+    for name, value in metrics.items():  # path_length, collisions: run_episode's figures win
+        row.setdefault(name, value)
+    row["wall_time"] = time.perf_counter() - t0
+    return row, record
+
+
+def _mp_context() -> Any:
+    import multiprocessing as mp
+
+    return mp.get_context("spawn")
+
+
+def run_benchmark(
+    suite: str | Path | Suite,
+    contest: str | Path | ContestFile,
+    run_dir: str | Path,
+    *,
+    base_cfg: ExperimentConfig | None = None,
+    workers: int = 1,
+    resume: bool = False,
+    scale: float = 1.0,
+    progress: bool | ProgressFn | None = None,
+    backend: str = "process",
+) -> Path:
+    """Run (or resume) a benchmark into ``run_dir``; return the run folder.
+
+    Args:
+        suite: packaged suite name, suite file or a loaded :class:`Suite` (then ``scale`` is
+            the suite's own ``scale_episodes``).
+        contest: packaged contest name, contest file or a loaded :class:`ContestFile`.
+        run_dir: the run folder (created); results land as in :mod:`arena.eval.store`.
+        base_cfg: the experiment every stage derives from (its ``seed`` is the run seed).
+        workers: parallel worker processes (1 = in this process).
+        resume: continue the run in ``run_dir``: skip its committed episodes. The suite,
+            contest, seed and scale must be the run's.
+        scale: factor on every stage's episode count.
+        progress: ``True`` shows a rich progress bar with ETA; a callable gets
+            ``(done, total, row)`` after every committed episode.
+        backend: ``"process"`` (``concurrent.futures``) or ``"ray"`` (needs ``ray``).
+
+    Raises:
+        ArenaError: a bad suite/contest, ``run_dir`` holding a run without ``resume``, a resume
+            with different settings, or ``backend="ray"`` without ray installed.
+    """
+    base_cfg = base_cfg or ExperimentConfig()
+    if workers < 1:
+        raise ArenaError(f"workers must be >= 1, got {workers}")
+    if backend not in ("process", "ray"):
+        raise ArenaError(f"unknown backend {backend!r}; expected 'process' or 'ray'")
+    if backend == "ray":
+        try:
+            import ray  # noqa: F401
+        except ImportError:
+            raise ArenaError(
+                "backend 'ray' needs the ray package (pip install ray); "
+                "or use the default backend 'process'"
+            ) from None
+    if isinstance(suite, Suite):
+        suite_obj, scale = suite, suite.scale_episodes
+    else:
+        suite_obj = load_suite(suite, scale_episodes=scale)
+    if isinstance(contest, ContestFile):
+        contest_obj, contest_src = contest, "<contest>"
+    else:
+        contest_obj, contest_src = load_contest(contest)
+    run = Path(run_dir)
+    suite_src = str(Path(suite_obj.source).resolve())
+    if contest_src != "<contest>":
+        contest_src = str(Path(contest_src).resolve())
+    settings: dict[str, Any] = {
+        "suite": suite_src, "contest": contest_src, "seed": int(base_cfg.seed),
+        "scale": float(scale),
+    }
+    jobs = plan_jobs(suite_obj, contest_obj, base_cfg, contest_source=contest_src)
+    if resume:
+        check_manifest(run, settings)
+    else:
+        if (run / MANIFEST).exists():
+            raise ArenaError(f"{run / MANIFEST}: {run} already holds a run; resume it instead")
+        run.mkdir(parents=True, exist_ok=True)
+        write_manifest(run, suite=suite_src, contest=contest_src, seed=int(base_cfg.seed),
+                       scale=float(scale))
+    done = completed(run)
+    todo = [j for j in jobs if j.key not in done]
+    total = len(jobs)
+    _execute(run, todo, total, total - len(todo), workers, progress, backend)
+    return run
+
+
+def _execute(
+    run: Path, todo: Sequence[Job], total: int, start: int, workers: int,
+    progress: bool | ProgressFn | None, backend: str,
+) -> None:
+    bar: Any = None
+    task: Any = None
+    if progress is True:
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
+
+        bar = Progress(
+            TextColumn("[bold]bench[/]"), BarColumn(), MofNCompleteColumn(),
+            TimeElapsedColumn(), TextColumn("ETA"), TimeRemainingColumn(),
+            TextColumn("{task.description}"),
+        )
+        bar.start()
+        task = bar.add_task("", total=total, completed=start)
+    count = start
+
+    def commit(result: tuple[dict[str, Any], EpisodeRecord | None]) -> None:
+        nonlocal count
+        row, record = result
+        commit_episode(run, row, record)
+        count += 1
+        if bar is not None:
+            bar.update(task, advance=1,
+                       description=f"{row['contestant']}/{row['stage']}/{row['episode']}: "
+                                   f"{row['outcome']}")
+        elif callable(progress):
+            progress(count, total, row)
+
+    try:
+        if backend == "ray":
+            _execute_ray(todo, workers, commit)
+        elif workers == 1 or len(todo) <= 1:
+            for job in todo:
+                commit(run_job(job))
+        else:
+            pool = ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context())
+            try:
+                pending: set[Future[Any]] = set()
+                queue = list(todo)
+                while queue or pending:
+                    while queue and len(pending) < 2 * workers:
+                        pending.add(pool.submit(run_job, queue.pop(0)))
+                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+                    for f in finished:
+                        commit(f.result())
+            except BaseException:  # Ctrl-C or a failed commit: drop the queued jobs, stop now
+                pool.shutdown(wait=False, cancel_futures=True)
+                raise
+            pool.shutdown(wait=True)
+    finally:
+        if bar is not None:
+            bar.stop()
+
+
+def _execute_ray(todo: Sequence[Job], workers: int, commit: Callable[[Any], None]) -> None:
+    """Run the jobs as ray tasks (at most ``workers`` at once); commit in the caller."""
+    import ray
+
+    if not ray.is_initialized():
+        ray.init(num_cpus=workers, include_dashboard=False)
+    remote = ray.remote(run_job)
+    queue = list(todo)
+    pending: list[Any] = []
+    while queue or pending:
+        while queue and len(pending) < workers:
+            pending.append(remote.remote(queue.pop(0)))
+        ready, pending = ray.wait(pending, num_returns=1)
+        for ref in ready:
+            commit(ray.get(ref))
+
+
+__all__ = ["Job", "load_results", "plan_jobs", "run_benchmark", "run_job"]

@@ -1,0 +1,271 @@
+"""A benchmark run's results store: one committed file pair per finished episode.
+
+Layout of a run folder::
+
+    run.json                                        the run manifest (suite, contest, seed, ...)
+    episodes/<contestant>/<stage>/<episode>.parquet the EpisodeRecord (arena.eval.io.load_record)
+    episodes/<contestant>/<stage>/<episode>.json    the metrics row, written last
+
+Every file is written to a temporary file in the same folder and moved into place with
+:func:`os.replace`, so a reader never sees a half-written file. The ``.json`` row is written
+after the record: its presence marks the episode as committed (:func:`completed`). A run killed
+at any moment therefore leaves only whole, committed episodes plus, at worst, an orphaned record
+or a temporary file, which a resumed run overwrites.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Iterable, Mapping
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+
+from arena import __version__
+from arena.core.errors import ArenaError
+from arena.eval.io import save_record
+from arena.eval.record import EpisodeRecord
+
+MANIFEST = "run.json"
+EPISODES = "episodes"
+#: Manifest keys a resumed run must match.
+MANIFEST_KEYS = ("suite", "contest", "seed", "scale")
+
+#: Columns of :func:`load_results` before the metric columns, with their types.
+ID_COLUMNS: tuple[tuple[str, pa.DataType], ...] = (
+    ("contestant", pa.string()),
+    ("local_planner", pa.string()),
+    ("inter_planner", pa.string()),
+    ("stage", pa.string()),
+    ("episode", pa.int64()),
+    ("seed", pa.int64()),
+    ("map", pa.string()),
+    ("robot", pa.string()),
+    ("outcome", pa.string()),
+)
+#: Columns of :func:`load_results` after the metric columns, with their types.
+TAIL_COLUMNS: tuple[tuple[str, pa.DataType], ...] = (
+    ("time", pa.float64()),
+    ("path_length", pa.float64()),
+    ("collisions", pa.int64()),
+    ("wall_time", pa.float64()),
+    ("error", pa.string()),
+    ("record", pa.string()),
+)
+
+
+def _atomic_write(path: Path, write: Any) -> None:
+    """Call ``write(tmp_path)`` on a temporary file next to ``path``, then move it into place."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _write_json(path: Path, data: Any) -> None:
+    def write(tmp: Path) -> None:
+        with tmp.open("w") as f:
+            json.dump(data, f, indent=1, allow_nan=True)
+            f.flush()
+            os.fsync(f.fileno())
+
+    _atomic_write(path, write)
+
+
+def _check_name(name: str, what: str) -> None:
+    if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
+        raise ArenaError(f"{what} name {name!r} cannot be a folder name")
+
+
+def episode_stem(run: Path, contestant: str, stage: str, episode: int) -> Path:
+    """``<run>/episodes/<contestant>/<stage>/<episode:04d>`` (no suffix)."""
+    _check_name(contestant, "contestant")
+    _check_name(stage, "stage")
+    return Path(run) / EPISODES / contestant / stage / f"{int(episode):04d}"
+
+
+# -- manifest ---------------------------------------------------------------------------------
+def write_manifest(
+    run: str | Path, *, suite: str, contest: str, seed: int, scale: float
+) -> dict[str, Any]:
+    """Write ``<run>/run.json`` for a new run and return it."""
+    data: dict[str, Any] = {
+        "suite": str(suite),
+        "contest": str(contest),
+        "seed": int(seed),
+        "scale": float(scale),
+        "created": datetime.now(UTC).isoformat(timespec="seconds"),
+        "arena_version": __version__,
+    }
+    _write_json(Path(run) / MANIFEST, data)
+    return data
+
+
+def read_manifest(run: str | Path) -> dict[str, Any]:
+    """Read ``<run>/run.json``.
+
+    Raises:
+        ArenaError: no manifest (not a run folder) or an unreadable one.
+    """
+    path = Path(run) / MANIFEST
+    if not path.is_file():
+        raise ArenaError(f"{path}: no run manifest; {run} is not a benchmark run folder")
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as e:
+        raise ArenaError(f"{path}: unreadable run manifest ({e})") from None
+    if not isinstance(data, dict):
+        raise ArenaError(f"{path}: the run manifest is not a JSON object")
+    return data
+
+
+def check_manifest(run: str | Path, expected: Mapping[str, Any]) -> dict[str, Any]:
+    """Check that a run folder's manifest matches ``expected`` on :data:`MANIFEST_KEYS`.
+
+    Raises:
+        ArenaError: naming the manifest file and the first field that differs.
+    """
+    data = read_manifest(run)
+    path = Path(run) / MANIFEST
+    for key in MANIFEST_KEYS:
+        if key not in expected:
+            continue
+        have, want = data.get(key), expected[key]
+        same = (
+            math.isclose(float(have), float(want))
+            if key == "scale" and isinstance(have, int | float)
+            else have == want
+        )
+        if not same:
+            raise ArenaError(
+                f"{path}: cannot resume: field {key!r} of the run is {have!r}, "
+                f"this call asks for {want!r}"
+            )
+    return data
+
+
+# -- episodes ---------------------------------------------------------------------------------
+def commit_episode(
+    run: str | Path,
+    row: Mapping[str, Any],
+    record: EpisodeRecord | None,
+) -> Path:
+    """Commit one finished episode: its record (if any), then its metrics row (last).
+
+    ``row`` holds the :func:`load_results` fields (``contestant``, ``stage``, ``episode`` ...)
+    and the metrics; ``record`` is filled in from where the record lands. Returns the row file.
+    """
+    run = Path(run)
+    stem = episode_stem(run, str(row["contestant"]), str(row["stage"]), int(row["episode"]))
+    data = dict(row)
+    data["record"] = ""
+    if record is not None:
+        target = stem.with_suffix(".parquet")
+        _atomic_write(target, lambda tmp: save_record(record, tmp))
+        data["record"] = target.relative_to(run).as_posix()
+    target = stem.with_suffix(".json")
+    _write_json(target, data)
+    return target
+
+
+def _row_files(run: Path) -> Iterable[Path]:
+    root = run / EPISODES
+    if not root.is_dir():
+        return []
+    return (p for p in root.glob("*/*/*.json") if not p.name.startswith("."))
+
+
+def completed(run: str | Path) -> set[tuple[str, str, int]]:
+    """``(contestant, stage, episode)`` of every committed episode of a run."""
+    out = set()
+    for p in _row_files(Path(run)):
+        try:
+            episode = int(p.stem)
+        except ValueError:
+            continue
+        out.add((p.parent.parent.name, p.parent.name, episode))
+    return out
+
+
+def load_rows(run: str | Path) -> list[dict[str, Any]]:
+    """Every committed metrics row, sorted by (contestant, stage, episode)."""
+    rows = []
+    for p in _row_files(Path(run)):
+        try:
+            rows.append(json.loads(p.read_text()))
+        except (OSError, json.JSONDecodeError) as e:
+            raise ArenaError(f"{p}: unreadable episode row ({e})") from None
+    rows.sort(key=lambda r: (str(r["contestant"]), str(r["stage"]), int(r["episode"])))
+    return rows
+
+
+def metric_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
+    """The metric names found in ``rows`` (every key that is no fixed column), sorted."""
+    fixed = {n for n, _ in ID_COLUMNS} | {n for n, _ in TAIL_COLUMNS}
+    return sorted({k for r in rows for k in r if k not in fixed})
+
+
+def load_results(run: str | Path) -> pa.Table:
+    """One row per committed episode: ids, outcome, every metric (float64), figures.
+
+    Columns: ``contestant, local_planner, inter_planner, stage, episode, seed, map, robot,
+    outcome``, the metrics (sorted by name), ``time, path_length, collisions, wall_time, error,
+    record`` (the record's path relative to the run folder; empty when the episode has none).
+    Rows are sorted by (contestant, stage, episode). A metric named like a fixed column
+    (``path_length``, ``collisions``) appears once, as the fixed column with its type.
+    """
+    rows = load_rows(run)
+    metrics = metric_columns(rows)
+    columns: dict[str, pa.Array] = {}
+    fields = []
+    for name, typ in ID_COLUMNS:
+        fields.append(pa.field(name, typ))
+        columns[name] = pa.array([r.get(name) for r in rows], type=typ)
+    for name in metrics:
+        fields.append(pa.field(name, pa.float64()))
+        vals = [r.get(name) for r in rows]
+        columns[name] = pa.array(
+            [math.nan if v is None else float(v) for v in vals], type=pa.float64()
+        )
+    for name, typ in TAIL_COLUMNS:
+        fields.append(pa.field(name, typ))
+        columns[name] = pa.array([r.get(name) for r in rows], type=typ)
+    schema = pa.schema(fields)
+    return pa.table([columns[f.name] for f in schema], schema=schema)
+
+
+def summarize(table: pa.Table) -> list[dict[str, Any]]:
+    """Per (contestant, stage), in table order: episodes, success rate, collisions, mean time.
+
+    ``collisions`` is the mean number of collision events per episode; ``time`` the mean episode
+    time over all episodes (s).
+    """
+    groups: dict[tuple[str, str], list[dict[str, Any]]] = {}
+    for r in table.select(["contestant", "stage", "outcome", "collisions", "time"]).to_pylist():
+        groups.setdefault((r["contestant"], r["stage"]), []).append(r)
+    out = []
+    for (contestant, stage), rs in groups.items():
+        n = len(rs)
+        times = [float(r["time"]) for r in rs if r["time"] is not None]
+        out.append(
+            {
+                "contestant": contestant,
+                "stage": stage,
+                "episodes": n,
+                "success_rate": sum(r["outcome"] == "success" for r in rs) / n,
+                "collisions": sum(int(r["collisions"] or 0) for r in rs) / n,
+                "time": sum(times) / len(times) if times else math.nan,
+                "errors": sum(r["outcome"] == "error" for r in rs),
+            }
+        )
+    return out

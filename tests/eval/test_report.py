@@ -1,0 +1,102 @@
+import math
+import re
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from arena.eval import report
+from arena.eval.io import save_record
+from arena.maps.grid import OccupancyGrid
+from tests.eval._records import make_record
+from tests.eval._table import CONTESTANTS, STAGES, build_table, values
+
+
+def _hand_ci(v):
+    v = np.asarray(v, float)
+    n = v.size
+    mean = sum(v) / n
+    s = math.sqrt(sum((x - mean) ** 2 for x in v) / (n - 1))
+    return mean, stats.t.ppf(0.975, n - 1) * s / math.sqrt(n)
+
+
+def test_summary_means_and_ci_by_hand():
+    rows = report.summary_table(build_table())
+    assert len(rows) == 2 * 2 * 7
+    by = {(r.contestant, r.stage, r.metric): r for r in rows}
+    for c, cn in enumerate(CONTESTANTS):
+        for s, sn in enumerate(STAGES):
+            for m, v in values(c, s).items():
+                r = by[(cn, sn, m)]
+                mean, ci = _hand_ci(v)
+                assert r.n == 5
+                assert r.mean == pytest.approx(mean)
+                assert r.ci == pytest.approx(ci)
+                assert r.lower == pytest.approx(mean - ci)
+    # time_to_goal alpha/easy: 10..14 -> mean 12, s = sqrt(2.5), t(0.975, 4) = 2.7764451
+    r = by[("alpha", "easy", "time_to_goal")]
+    assert r.mean == pytest.approx(12.0)
+    assert r.ci == pytest.approx(2.7764451 * math.sqrt(2.5) / math.sqrt(5), rel=1e-6)
+    assert r.unit == "s"
+
+
+def test_write_tables_csv_and_latex(tmp_path):
+    csv_path, tex_path = report.write_tables(build_table(), tmp_path / "out")
+    lines = csv_path.read_text().splitlines()
+    assert lines[0].startswith("contestant,stage,metric,unit,n,mean,ci95")
+    assert len(lines) == 1 + 28
+    tex = tex_path.read_text()
+    assert r"\toprule" in tex and r"\midrule" in tex and r"\bottomrule" in tex
+    ci = 2.7764451 * math.sqrt(2.5) / math.sqrt(5)
+    assert rf"time\_to\_goal [s] & alpha & easy & 5 & 12.000 $\pm$ {ci:.3f} \\" in tex
+    # beta/hard time_to_goal: 15..19 -> mean 17
+    assert rf"time\_to\_goal [s] & beta & hard & 5 & 17.000 $\pm$ {ci:.3f} \\" in tex
+    assert tex.count(r"\\") == 28 + 1
+
+
+def _write_records(run):
+    recs = []
+    for c in CONTESTANTS:
+        for s in STAGES:
+            for i in range(5):
+                rel = f"episodes/{c}/{s}/{i}.parquet"
+                n = 10
+                pose = np.stack([np.linspace(0, 4, n), np.full(n, 0.3 * i + 1), np.zeros(n)], 1)
+                coll = np.zeros(n, bool)
+                coll[5] = i == 3
+                save_record(make_record(pose, collision=coll), run / rel)
+                recs.append(rel)
+    return recs
+
+
+def test_write_report_self_contained(tmp_path):
+    run = tmp_path / "run"
+    recs = _write_records(run)
+    video = tmp_path / "ep.mp4"
+    video.write_bytes(b"\x00\x00\x00\x18ftypmp42fake")
+    grid = OccupancyGrid(np.zeros((30, 30), np.int8), 0.2)
+    out = report.write_report(build_table(recs), run, tmp_path / "r" / "report.html",
+                              grids={"m": grid}, videos=[video], kinds=("bar", "box"))
+    text = out.read_text()
+    assert text.startswith("<!DOCTYPE html>")
+    assert 'src="http' not in text and "href=\"http" not in text and "<link" not in text
+    srcs = re.findall(r'src="([^"]*)"', text)
+    assert srcs and all(s.startswith("data:") for s in srcs)
+    n_png = sum(s.startswith("data:image/png;base64,") for s in srcs)
+    # 7 metrics x 2 kinds + radar + 4 trajectory plots
+    assert n_png == 7 * 2 + 1 + 4
+    assert any(s.startswith("data:video/mp4;base64,") for s in srcs)
+    for c in CONTESTANTS:
+        assert c in text
+    assert "Time to goal [s]" in text and "12.000 ± " in text
+
+
+def test_main_reads_store(tmp_path, monkeypatch):
+    run = tmp_path / "run"
+    recs = _write_records(run)
+    import arena.eval.store as store
+
+    monkeypatch.setattr(store, "load_results", lambda r: build_table(recs))
+    paths = report.main(run)
+    assert paths["html"] == run / "report" / "report.html"
+    assert paths["html"].is_file() and paths["csv"].is_file() and paths["tex"].is_file()
