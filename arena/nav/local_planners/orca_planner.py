@@ -35,7 +35,7 @@ from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
 from arena.crowd.models.orca import RVO_EPSILON, _agent_line, _lp2, _lp3
 from arena.nav.local_planners.base import (
@@ -44,7 +44,12 @@ from arena.nav.local_planners.base import (
     LocalObservation,
     stopping_speed,
 )
-from arena.nav.local_planners.path_tracking import PathTracker, cluster_points, goal_command
+from arena.nav.local_planners.path_tracking import (
+    PathTracker,
+    TrackingParams,
+    cluster_points,
+    goal_command,
+)
 from arena.nav.local_planners.social_force import (
     cap_by_returns,
     lookahead_target,
@@ -101,7 +106,7 @@ class OrcaPlanner:
 
     supports: ClassVar[frozenset[str]] = KINEMATICS
 
-    class Params(BaseModel):
+    class Params(TrackingParams):
         """Parameters of :class:`OrcaPlanner`."""
 
         model_config = ConfigDict(frozen=True, extra="forbid")
@@ -120,22 +125,6 @@ class OrcaPlanner:
         )
         margin: float = Field(0.05, ge=0, description="m, clearance added to the robot radius")
         reach: float = Field(3.0, gt=0, description="m, returns beyond this are ignored")
-        stop_distance: float = Field(
-            0.1, ge=0, description="m, gap to a laser return ahead at which the robot stops"
-        )
-        decel_fraction: float = Field(
-            0.8, gt=0, le=1, description="share of the acceleration limit used for braking"
-        )
-        heading_gain: float = Field(2.0, gt=0, description="1/s, yaw rate per rad of error")
-        rotate_threshold: float = Field(
-            1.0, gt=0, description="rad, heading error beyond which diff drives turn in place"
-        )
-        goal_tolerance: float = Field(
-            0.05, gt=0, description="m, distance to the path end at which the planner stops"
-        )
-        goal_yaw_tolerance: float = Field(
-            0.05, gt=0, description="rad, heading error accepted when aligning at the goal"
-        )
 
     def __init__(self, params: Params | None = None) -> None:
         self.params = params if params is not None else self.Params()

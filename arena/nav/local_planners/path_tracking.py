@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.types import wrap_angle_scalar
 from arena.nav.local_planners.base import LocalObservation, limit_command
@@ -181,6 +182,28 @@ def free_distance(
         return math.inf
     gap = along[ahead] - np.sqrt(np.maximum(radius * radius - lateral[ahead] ** 2, 0.0))
     return float(max(np.min(gap), 0.0))
+
+
+class TrackingParams(BaseModel):
+    """Path-tracking and goal parameters shared by the reactive planners (social force, ORCA)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    stop_distance: float = Field(
+        0.1, ge=0, description="m, gap to a laser return ahead at which the robot stops"
+    )
+    decel_fraction: float = Field(
+        0.8, gt=0, le=1, description="share of the acceleration limit used for braking"
+    )
+    heading_gain: float = Field(2.0, gt=0, description="1/s, yaw rate per rad of error")
+    rotate_threshold: float = Field(
+        1.0, gt=0, description="rad, heading error beyond which diff drives turn in place"
+    )
+    goal_tolerance: float = Field(
+        0.05, gt=0, description="m, distance to the path end at which the planner stops"
+    )
+    goal_yaw_tolerance: float = Field(
+        0.05, gt=0, description="rad, heading error accepted when aligning at the goal"
+    )
 
 
 def finish_command(

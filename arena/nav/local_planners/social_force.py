@@ -41,7 +41,7 @@ from typing import ClassVar
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
 from arena.nav.local_planners.base import (
     KINEMATICS,
@@ -52,6 +52,7 @@ from arena.nav.local_planners.base import (
 )
 from arena.nav.local_planners.path_tracking import (
     PathTracker,
+    TrackingParams,
     cluster_points,
     finish_command,
     free_distance,
@@ -146,7 +147,7 @@ class SocialForcePlanner:
 
     supports: ClassVar[frozenset[str]] = KINEMATICS
 
-    class Params(BaseModel):
+    class Params(TrackingParams):
         """Parameters of :class:`SocialForcePlanner`."""
 
         model_config = ConfigDict(frozen=True, extra="forbid")
@@ -169,22 +170,6 @@ class SocialForcePlanner:
             0.2, gt=0, description="m, laser returns within this of a kept one are merged"
         )
         reach: float = Field(2.0, gt=0, description="m, returns beyond this do not repel")
-        stop_distance: float = Field(
-            0.1, ge=0, description="m, gap to a laser return ahead at which the robot stops"
-        )
-        decel_fraction: float = Field(
-            0.8, gt=0, le=1, description="share of the acceleration limit used for braking"
-        )
-        heading_gain: float = Field(2.0, gt=0, description="1/s, yaw rate per rad of error")
-        rotate_threshold: float = Field(
-            1.0, gt=0, description="rad, heading error beyond which diff drives turn in place"
-        )
-        goal_tolerance: float = Field(
-            0.05, gt=0, description="m, distance to the path end at which the planner stops"
-        )
-        goal_yaw_tolerance: float = Field(
-            0.05, gt=0, description="rad, heading error accepted when aligning at the goal"
-        )
 
     def __init__(self, params: Params | None = None) -> None:
         self.params = params if params is not None else self.Params()
