@@ -204,12 +204,50 @@ def _load_records(
     return out
 
 
-def _grid_for(grids: Any, records: Sequence[EpisodeRecord]) -> Any:
-    if grids is None or not records:
+def episode_grid(record: EpisodeRecord) -> Any:
+    """The map an episode ran on, obstacles burnt in, rebuilt from its recorded config.
+
+    Episodes are pure functions of (config, seed, index), so redrawing episode
+    ``record.meta.episode`` from ``record.meta.config`` gives the same map and obstacles,
+    generated or not. ``None`` if the record has no config or it no longer loads.
+    """
+    from arena.config.schema import ExperimentConfig
+    from arena.core.errors import ArenaError
+    from arena.experiment import planning_grid
+    from arena.tasks.generator import TaskGenerator
+
+    if not record.meta.config:
         return None
+    try:
+        cfg = ExperimentConfig.model_validate(record.meta.config)
+        return planning_grid(TaskGenerator.from_config(cfg).episode(record.meta.episode))
+    except (ArenaError, ValueError):
+        return None
+
+
+def _grid_for(
+    grids: Any, records: Sequence[EpisodeRecord]
+) -> tuple[Any, Sequence[EpisodeRecord]]:
+    """The background grid for a trajectory plot and the records that belong on it.
+
+    With ``grids=None`` the maps are rebuilt from the records' configs; records on another map
+    than the first (generated maps change per episode) are left out of that plot.
+    """
+    if not records:
+        return None, records
     if isinstance(grids, Mapping):
-        return grids.get(records[0].meta.map_name)
-    return grids
+        return grids.get(records[0].meta.map_name), records
+    if grids is not None:
+        return grids, records
+    first = episode_grid(records[0])
+    if first is None:
+        return None, records
+    same = [records[0]]
+    for r in records[1:]:
+        g = episode_grid(r)
+        if g is not None and g == first:
+            same.append(r)
+    return first, same
 
 
 def write_report(
@@ -237,7 +275,8 @@ def write_report(
         run_dir: the run folder (records are resolved relative to it).
         out_html: the HTML file to write.
         grids: an :class:`~arena.maps.grid.OccupancyGrid` for every trajectory plot, or a mapping
-            ``map_name -> grid``; ``None`` = blank background.
+            ``map_name -> grid``; ``None`` = rebuild each episode's map from its recorded config
+            (:func:`episode_grid`; blank background if that fails).
         videos: MP4 files to embed.
         title: page title.
         kinds: plot kinds to draw per metric.
@@ -305,8 +344,8 @@ def write_report(
                 mask &= cols["stage"] == s
             recs = _load_records(cols, run_dir, mask, trajectories_per_group)
             if recs:
-                fig = plots.plot_trajectories(recs, _grid_for(grids, recs),
-                                              title=f"{c} / {s}" if s else c)
+                grid, shown = _grid_for(grids, recs)
+                fig = plots.plot_trajectories(shown, grid, title=f"{c} / {s}" if s else c)
                 traj.append(_img(fig, f"trajectories {c} {s}"))
     if traj:
         parts.append(f'<h2>Trajectories</h2><div class="figs">{"".join(traj)}</div>')

@@ -100,3 +100,31 @@ def test_main_reads_store(tmp_path, monkeypatch):
     paths = report.main(run)
     assert paths["html"] == run / "report" / "report.html"
     assert paths["html"].is_file() and paths["csv"].is_file() and paths["tex"].is_file()
+
+
+def test_trajectory_maps_are_rebuilt_from_the_records(tmp_path):
+    from arena.config.loader import load_config
+    from arena.eval.io import load_record
+    from arena.eval.report import _grid_for, episode_grid
+    from arena.experiment import planning_grid, run_experiment
+    from arena.tasks.generator import TaskGenerator
+
+    def records(extra, name):
+        cfg = load_config(None, ["output.video=false", "episodes=2", "task.timeout=2",
+                                 "task.obstacles.dynamic=1", *extra])
+        out, _ = run_experiment(cfg, tmp_path / name)
+        recs = [load_record(out / f"episode_{i:03d}" / "episode.parquet") for i in range(2)]
+        return cfg, recs
+
+    cfg, recs = records([], "office")  # one world map, random obstacles per episode
+    expected = planning_grid(TaskGenerator.from_config(cfg).episode(1))
+    assert episode_grid(recs[1]) == expected
+    assert episode_grid(recs[0]) != expected  # the placed obstacles are part of the map drawn
+    _, recs = records(["task.obstacles.static=0"], "bare")  # the same map in both episodes
+    grid, shown = _grid_for(None, recs)
+    assert grid == episode_grid(recs[0]) and len(shown) == 2
+    _, recs = records(["map.type=barn", "map.width=12", "map.height=10",
+                       "task.robots.min_goal_distance=3",
+                       "task.modules=[{type: dynamic_map, episodes_per_map: 1}]"], "barn")
+    grid, shown = _grid_for(None, recs)
+    assert grid is not None and len(shown) == 1  # a new map per episode: one per plot
