@@ -63,3 +63,46 @@ def post_scan(pose: np.ndarray, centre: np.ndarray, radius: float,
     disc = b * b - (rel @ rel - radius * radius)
     t = b - np.sqrt(np.maximum(disc, 0.0))
     return np.where((disc >= 0) & (t > 0), t, np.inf), angles
+
+
+def random_case(
+    rng: np.random.Generator, lim: VelocityLimits, kin: str
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """A random admissible twist, pose, 4-point path and 90-beam scan for drive ``kin``."""
+    twist = rng.uniform(lim.lower, lim.upper)
+    if not lim.holonomic:
+        twist[1] = 0.0
+    if kin == "ackermann":
+        twist[0] = abs(twist[0])
+        twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
+    pose = rng.uniform([-1, -1, -3], [1, 1, 3])
+    path = np.vstack([pose[:2], pose[:2] + rng.normal(0, 2, (3, 2)).cumsum(axis=0)])
+    ranges = rng.uniform(0.4, 5.0, 90)
+    angles = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+    return twist, pose, path, ranges, angles
+
+
+def assert_within_limits(cmd: np.ndarray, twist: np.ndarray, lim: VelocityLimits, kin: str) -> None:
+    """``cmd`` lies in the velocity box and one step's acceleration from ``twist``; car-like
+    robots keep ``|ω| ≤ |v| / r_min`` instead of the yaw-acceleration bound."""
+    room = lim.acceleration * DT + 1e-9
+    assert np.all(cmd >= lim.lower - 1e-9) and np.all(cmd <= lim.upper + 1e-9)
+    assert abs(cmd[0] - twist[0]) <= room[0] and abs(cmd[1] - twist[1]) <= room[1]
+    if kin == "ackermann":
+        assert abs(cmd[2]) <= abs(cmd[0]) / lim.min_turning_radius + 1e-9
+    else:
+        assert abs(cmd[2] - twist[2]) <= room[2]
+
+
+BEHIND_ASIDE = np.array([[0.0, 0.0], [-1.0, 2.0], [-3.0, 2.5]])
+"""A path to a goal behind and to the left of a robot at the origin facing +x."""
+
+
+def drive(planner, path: np.ndarray, kin: str, steps: int) -> tuple[np.ndarray, np.ndarray]:
+    """Run ``planner`` closed loop from the origin at rest for ``steps`` ticks (ideal robot)."""
+    lim = DRIVES[kin]
+    pose, twist = np.array([0.0, 0.0, 0.0]), np.zeros(3)
+    for _ in range(steps):
+        cmd = planner.compute(obs(pose, path, twist, lim, kin))
+        pose, twist = step(pose, cmd), cmd
+    return pose, twist

@@ -15,7 +15,16 @@ from arena.config import load_config
 from arena.experiment import run_experiment
 from arena.nav.local_planners import LOCAL_PLANNERS, MPCPlanner
 from arena.robots.limits import VelocityLimits
-from tests.nav.planner_kit import CAR, DIFF, DRIVES, DT, RADIUS
+from tests.nav.planner_kit import (
+    BEHIND_ASIDE,
+    CAR,
+    DIFF,
+    DRIVES,
+    RADIUS,
+    assert_within_limits,
+    drive,
+    random_case,
+)
 from tests.nav.planner_kit import line as _line
 from tests.nav.planner_kit import obs as _obs
 from tests.nav.planner_kit import post_scan as _post_scan
@@ -52,36 +61,16 @@ def test_commands_stay_within_limits(kin: str) -> None:
     rng = np.random.default_rng(3)
     planner = _mpc()
     for _ in range(15):
-        twist = rng.uniform(lim.lower, lim.upper)
-        if not lim.holonomic:
-            twist[1] = 0.0
-        if kin == "ackermann":
-            twist[0] = abs(twist[0])
-            twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
-        pose = rng.uniform([-1, -1, -3], [1, 1, 3])
-        path = np.vstack([pose[:2], pose[:2] + rng.normal(0, 2, (3, 2)).cumsum(axis=0)])
-        ranges = rng.uniform(0.4, 5.0, 90)
-        angles = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+        twist, pose, path, ranges, angles = random_case(rng, lim, kin)
         cmd = planner.compute(_obs(pose, path, twist, lim, kin, ranges, angles))
-        room = lim.acceleration * DT + 1e-9
-        assert np.all(cmd >= lim.lower - 1e-9) and np.all(cmd <= lim.upper + 1e-9)
-        assert abs(cmd[0] - twist[0]) <= room[0] and abs(cmd[1] - twist[1]) <= room[1]
-        if kin == "ackermann":
-            assert abs(cmd[2]) <= abs(cmd[0]) / lim.min_turning_radius + 1e-9
-        else:
-            assert abs(cmd[2] - twist[2]) <= room[2]
+        assert_within_limits(cmd, twist, lim, kin)
 
 
 @pytest.mark.parametrize("kin", ["diff_drive", "omni", "legged"])
 def test_reaches_a_goal_behind_and_aside(kin: str) -> None:
-    lim = DRIVES[kin]
     planner = _mpc()
-    path = np.array([[0.0, 0.0], [-1.0, 2.0], [-3.0, 2.5]])
-    pose, twist = np.array([0.0, 0.0, 0.0]), np.zeros(3)
-    for _ in range(300):
-        cmd = planner.compute(_obs(pose, path, twist, lim, kin))
-        pose, twist = _step(pose, cmd), cmd
-    assert np.linalg.norm(pose[:2] - path[-1]) < 0.1
+    pose, twist = drive(planner, BEHIND_ASIDE, kin, 300)
+    assert np.linalg.norm(pose[:2] - BEHIND_ASIDE[-1]) < 0.1
     assert np.allclose(twist, 0.0, atol=0.3)
     assert planner.failures == 0
 

@@ -66,6 +66,21 @@ def _sift_up(heap: NDArray, hf: NDArray, hg: NDArray, pos: NDArray, i: int) -> N
 
 
 @njit(cache=True)
+def _pop_min(heap: NDArray, hf: NDArray, hg: NDArray, pos: NDArray, size: int) -> int:
+    """Remove the heap's root (the caller read it first), mark it closed; return the new size."""
+    u = heap[0]
+    size -= 1
+    if size > 0:
+        heap[0] = heap[size]
+        hf[0] = hf[size]
+        hg[0] = hg[size]
+        pos[heap[0]] = 0
+        _sift_down(heap, hf, hg, pos, 0, size)
+    pos[u] = -2
+    return size
+
+
+@njit(cache=True)
 def _sift_down(heap: NDArray, hf: NDArray, hg: NDArray, pos: NDArray, i: int, n: int) -> None:
     node, f, g = heap[i], hf[i], hg[i]
     while True:
@@ -134,14 +149,7 @@ def _astar_cells(
     found = False
     while size > 0:
         u = heap[0]
-        size -= 1
-        if size > 0:
-            heap[0] = heap[size]
-            hf[0] = hf[size]
-            hg[0] = hg[size]
-            pos[heap[0]] = 0
-            _sift_down(heap, hf, hg, pos, 0, size)
-        pos[u] = -2
+        size = _pop_min(heap, hf, hg, pos, size)
         if u == goal:
             found = True
             break

@@ -30,7 +30,7 @@ from pydantic import BaseModel, ConfigDict
 from arena.core.errors import NoPathFound
 from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
-from arena.nav.global_planners.astar import _line_cost, _sift_down, _sift_up
+from arena.nav.global_planners.astar import _line_cost, _pop_min, _sift_up
 from arena.nav.global_planners.base import GLOBAL_PLANNERS, endpoint_cells
 
 _SQRT2 = math.sqrt(2.0)
@@ -87,14 +87,7 @@ def _theta_star_cells(
     found = False
     while size > 0:
         u = heap[0]
-        size -= 1
-        if size > 0:
-            heap[0] = heap[size]
-            hf[0] = hf[size]
-            hg[0] = hg[size]
-            pos[heap[0]] = 0
-            _sift_down(heap, hf, hg, pos, 0, size)
-        pos[u] = -2
+        size = _pop_min(heap, hf, hg, pos, size)
         if u == goal:
             found = True
             break
