@@ -20,6 +20,7 @@ Output layout (``output.dir``)::
 from __future__ import annotations
 
 import csv
+import dataclasses
 import json
 import math
 import time
@@ -38,6 +39,7 @@ from arena.core.errors import ArenaError, PlanningError
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
+from arena.eval.counterfactual import align, replay_crowd
 from arena.eval.io import save_record
 from arena.eval.record import EpisodeMeta, EpisodeRecord
 from arena.eval.recorder import Recorder
@@ -368,6 +370,15 @@ def run_episode(
             config=cfg.model_dump(mode="json"),
         )
     )
+    if cfg.evaluation.counterfactual and len(episode.agents):
+        # The same crowd without the robot, from the stream the backend gave the pedestrians.
+        track = replay_crowd(
+            cfg.crowd, cfg.pedestrians, episode, state.step, dt,
+            derive_rng(seed, "episode", idx, "sim"),
+        )
+        record = dataclasses.replace(
+            record, ped_cf_position=align(record.ped_row, record.ped_id, track)
+        )
     poses = recorder.poses
     steps = np.hypot(*np.diff(poses[:, :2], axis=0).T) if len(poses) > 1 else np.zeros(0)
     for row in jumps:  # a teleport is no distance driven

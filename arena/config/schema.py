@@ -42,6 +42,16 @@ class OutputConfig(_Strict):
     width_px: int = Field(800, ge=200, le=4000, description="video frame width")
 
 
+class EvaluationConfig(_Strict):
+    """What is recorded with each episode besides the simulated steps."""
+
+    counterfactual: bool = Field(
+        True,
+        description="replay the crowd without the robot (same seed) so that the cf_* metrics "
+        "measure how far the robot displaced people; one crowd-only simulation per episode",
+    )
+
+
 class ExperimentConfig(_Strict):
     """One experiment: a robot, a map, a task, a crowd, a navigation stack, a simulator."""
 
@@ -61,3 +71,4 @@ class ExperimentConfig(_Strict):
     navigation: NavigationConfig = Field(default_factory=NavigationConfig)
     sim: SimConfig = Field(default_factory=SimConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
+    evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)

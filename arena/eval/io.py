@@ -6,9 +6,11 @@ min_range`` (float64) and ``collision_wall, collision_obstacle, collision_pedest
 collision_robot`` (bool). The pedestrian table (``K`` rows, long format) is stored in the same
 file as list columns, each robot row holding the pedestrians of that step: ``ped_id, ped_kind,
 ped_state`` (list<int64>), ``ped_x, ped_y, ped_vx, ped_vy, ped_heading, ped_radius``
-(list<float64>). ``ped_row`` is implied by the list a pedestrian sits in. The meta data (with
-the resolved config) and the events are JSON in the schema metadata under ``arena.meta`` and
-``arena.events`` (plus ``arena.format`` = ``"episode-record/1"``).
+(list<float64>), and, when the record has a counterfactual crowd, ``ped_cf_x, ped_cf_y``
+(list<float64>, NaN where the replay lacks the person). ``ped_row`` is implied by the list a
+pedestrian sits in. The meta data (with the resolved config) and the events are JSON in the
+schema metadata under ``arena.meta`` and ``arena.events`` (plus ``arena.format`` =
+``"episode-record/1"``).
 
 The round trip is exact (values and dtypes) for records whose pedestrian rows are grouped by
 step in increasing ``ped_row`` order, which is what :class:`~arena.eval.recorder.Recorder`
@@ -38,6 +40,7 @@ _ROBOT_FLOATS = ("time", "x", "y", "theta", "vx", "vy", "omega",
 _COLLISIONS = ("collision_wall", "collision_obstacle", "collision_pedestrian", "collision_robot")
 _PED_INTS = ("ped_id", "ped_kind", "ped_state")
 _PED_FLOATS = ("ped_x", "ped_y", "ped_vx", "ped_vy", "ped_heading", "ped_radius")
+_PED_CF = ("ped_cf_x", "ped_cf_y")
 
 #: Arena's recorder writes ``secs × 10e9 + nsecs`` (10e9 = 1e10, a quirk); its metrics divide
 #: by 1e10. We write ``round(seconds × 1e10)`` so that Arena's division gives back seconds.
@@ -110,6 +113,11 @@ def record_to_table(record: EpisodeRecord) -> pa.Table:
     floats = np.column_stack([r.ped_position, r.ped_velocity, r.ped_heading, r.ped_radius])
     for j, name in enumerate(_PED_FLOATS):
         cols[name] = _list_column(np.ascontiguousarray(floats[order, j]), offsets, pa.float64())
+    if r.ped_cf_position is not None:
+        for j, name in enumerate(_PED_CF):
+            cols[name] = _list_column(
+                np.ascontiguousarray(r.ped_cf_position[order, j]), offsets, pa.float64()
+            )
     meta = {
         "arena.format": FORMAT,
         "arena.meta": json.dumps(_meta_to_json(r.meta)),
@@ -141,6 +149,11 @@ def table_to_record(table: pa.Table) -> EpisodeRecord:
             for n in _PED_INTS}
     fl = {n: col(n).flatten().to_numpy(zero_copy_only=False).astype(np.float64)
           for n in _PED_FLOATS}
+    cf = None
+    if _PED_CF[0] in table.column_names:
+        cf = np.column_stack([
+            col(n).flatten().to_numpy(zero_copy_only=False).astype(np.float64) for n in _PED_CF
+        ]).reshape(-1, 2)
     return EpisodeRecord(
         meta=meta,
         time=robot[:, 0].copy(),
@@ -161,6 +174,7 @@ def table_to_record(table: pa.Table) -> EpisodeRecord:
         ped_heading=fl["ped_heading"],
         ped_radius=fl["ped_radius"],
         events=events,
+        ped_cf_position=cf,
     )
 
 

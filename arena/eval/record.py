@@ -76,6 +76,11 @@ class EpisodeRecord:
         ped_position: ``(K, 2)`` m; ped_velocity: ``(K, 2)`` m/s; ped_heading: ``(K,)`` rad.
         ped_radius: ``(K,)`` m.
 
+    Counterfactual (optional): ``ped_cf_position`` ``(K, 2)`` m, where each pedestrian row's
+    person would have been at that step had there been no robot
+    (:mod:`arena.eval.counterfactual`); NaN where the replay has no such person, ``None`` when
+    no replay was made.
+
     Events: ``events`` is a list of ``(time s, kind, detail)``, e.g. ``(12.3, "goal_reached",
     "")``, ``(4.0, "teleport", "robot 0")``.
     """
@@ -99,6 +104,7 @@ class EpisodeRecord:
     ped_heading: FloatArray
     ped_radius: FloatArray
     events: list[tuple[float, str, str]] = field(default_factory=list)
+    ped_cf_position: FloatArray | None = None
 
     def __post_init__(self) -> None:
         t = self.time.shape[0]
@@ -113,8 +119,9 @@ class EpisodeRecord:
         for name in ("ped_id", "ped_kind", "ped_state", "ped_heading", "ped_radius"):
             if getattr(self, name).shape != (k,):
                 raise ValueError(f"EpisodeRecord.{name} must have shape ({k},)")
-        for name in ("ped_position", "ped_velocity"):
-            if getattr(self, name).shape != (k, 2):
+        for name in ("ped_position", "ped_velocity", "ped_cf_position"):
+            value = getattr(self, name)
+            if value is not None and value.shape != (k, 2):
                 raise ValueError(f"EpisodeRecord.{name} must have shape ({k}, 2)")
         if k and (self.ped_row.min() < 0 or self.ped_row.max() >= t):
             raise ValueError("EpisodeRecord.ped_row must index the robot rows")

@@ -70,4 +70,17 @@ class SimulatorBackend(Protocol):
         ...
 
 
+def split_rng(rng: np.random.Generator) -> tuple[np.random.Generator, np.random.Generator]:
+    """The two independent streams a backend makes of its ``reset`` generator.
+
+    Returns ``(pedestrians, sensors)``: the pedestrian driver draws only from the first, sensor
+    noise only from the second. Every backend splits this way, so the crowd's random draws do not
+    depend on how many scans the robots took; that is what lets
+    :mod:`arena.eval.counterfactual` replay an episode's crowd without the robot and get the
+    same draws.
+    """
+    crowd, sensors = rng.spawn(2)
+    return crowd, sensors
+
+
 BACKENDS: Registry[SimulatorBackend] = Registry("simulator backend", entry_points="arena.backends")

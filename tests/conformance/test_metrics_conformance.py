@@ -13,14 +13,21 @@ from tests.eval._records import make_record, straight
 
 
 def _records():
+    import dataclasses
+
     rng = np.random.default_rng(0)
     n = 40
     pose = np.cumsum(rng.normal(0, 0.1, (n, 3)), axis=0)
     vel = rng.normal(0, 0.5, (n, 3))
     peds = [(j, i, *rng.normal(0, 1.5, 2), *rng.normal(0, 1, 2), rng.uniform(-3, 3), 0.25)
             for j in range(n) for i in range(4)]
+    crowd = make_record(pose, vel, peds=peds, outcome="collision",
+                        min_range=rng.uniform(0.3, 4, n))
+    cf = crowd.ped_position + rng.normal(0, 0.2, crowd.ped_position.shape)
+    cf[::7] = np.nan  # people the replay does not have
     return [
         straight(),
+        dataclasses.replace(crowd, ped_cf_position=cf),
         straight(n=1),
         straight(n=2, collision=[1, 0]),
         make_record(pose, vel, peds=peds, outcome="collision", min_range=rng.uniform(0.3, 4, n)),

@@ -144,3 +144,23 @@ def test_path_irregularity_and_compute_metrics():
     out = compute_metrics(rec, ["path_length", "velocity"], {"private_zone_radius": 1.0})
     assert list(out) == ["path_length", "velocity"]
     assert len(compute_metrics(rec)) >= 30
+
+
+def test_counterfactual_displacement_by_hand():
+    import dataclasses
+
+    rec0 = straight(n=3)
+    # ids 1 and 2 at rows 0..2; id 2 is missing from the replay at row 2.
+    peds = [(j, i, float(i), 1.0, 0, 0, 0, 0.2) for j in range(3) for i in (1, 2)]
+    rec = make_record(rec0.pose, rec0.velocity, peds=peds)
+    assert all(math.isnan(m(n, rec)) for n in
+               ("cf_displacement_mean", "cf_displacement_max", "cf_people_displaced"))
+    cf = rec.ped_position.copy()
+    cf[1] += [0.3, 0.4]  # row 0, id 2: 0.5 m
+    cf[3] += [0.0, 0.1]  # row 1, id 2: 0.1 m
+    cf[5] = np.nan       # row 2, id 2: unknown
+    rec = dataclasses.replace(rec, ped_cf_position=cf)
+    assert m("cf_displacement_mean", rec) == pytest.approx((0.5 + 0.1) / 5)
+    assert m("cf_displacement_max", rec) == pytest.approx(0.5)
+    assert m("cf_people_displaced", rec) == pytest.approx(1 / 2)  # id 2 only (0.5 > 0.2 m)
+    assert m("cf_people_displaced", rec, cf_displacement_threshold=0.6) == 0.0

@@ -73,6 +73,10 @@ class MetricParams(BaseModel, frozen=True, extra="forbid"):
         2.1, gt=0, description="m/s², Helbing repulsion strength A (Helbing & Molnár 1995)"
     )
     social_force_b: float = Field(0.3, gt=0, description="m, Helbing repulsion range B")
+    cf_displacement_threshold: float = Field(
+        0.2, gt=0, description="m, a person farther than this from their counterfactual "
+        "position (the crowd replayed without the robot) counts as displaced",
+    )
     goal_tolerance: float = Field(
         1e-9, ge=0, description="m, float slack added to the goal radius in the success test"
     )

@@ -21,7 +21,7 @@ from arena.core.errors import SimulationError
 from arena.core.types import Pose2D
 from arena.robots.kinematics.base import KinematicState
 from arena.sensors.lidar2d import Lidar2D
-from arena.sim.backend import BACKENDS, PedestrianDriver
+from arena.sim.backend import BACKENDS, PedestrianDriver, split_rng
 from arena.sim.native2d.collisions import (
     Footprint,
     ObstacleIndex,
@@ -83,11 +83,15 @@ class Native2DBackend:
     def reset(
         self, episode: Episode, pedestrians: PedestrianDriver | None, rng: np.random.Generator
     ) -> SimState:
-        """Start ``episode``; ``rng`` feeds the sensor noise, ``pedestrians`` moves the agents."""
+        """Start ``episode``; ``pedestrians`` moves the agents.
+
+        ``rng`` is split by :func:`~arena.sim.backend.split_rng`: the pedestrians get the first
+        stream, the sensor noise the second.
+        """
         world = StaticWorld.build(episode.grid, episode.obstacles)
         self._world = world
         self._obstacles = ObstacleIndex.build(world)
-        self._rng = rng
+        crowd_rng, self._rng = split_rng(rng)
         robots = episode.robots
         if not robots:
             raise SimulationError("an episode needs at least one robot")
@@ -119,7 +123,7 @@ class Native2DBackend:
         self._step = 0
         self._driver = pedestrians
         if pedestrians is not None:
-            self._agents = pedestrians.reset(episode.agents, world, rng)
+            self._agents = pedestrians.reset(episode.agents, world, crowd_rng)
         else:
             self._agents = _standing_agents(episode)
         self._walked = np.zeros(len(self._agents))
