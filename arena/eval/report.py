@@ -149,13 +149,26 @@ def write_tables(table: Any, out: str | Path) -> tuple[Path, Path]:
 
 # -- HTML ------------------------------------------------------------------------------------------
 _CSS = """
-body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1200px;color:#222}
-h1{border-bottom:2px solid #444}table{border-collapse:collapse;font-size:0.85em;margin:1em 0}
-th,td{padding:2px 8px;border-bottom:1px solid #ddd;text-align:right}
+body{font-family:system-ui,'DejaVu Sans',sans-serif;margin:2em auto;max-width:1200px;
+padding:0 1em;color:#222;line-height:1.35}
+h1{border-bottom:2px solid #444}h2{margin-top:1.6em;border-bottom:1px solid #ccc}
+.scroll{overflow-x:auto;max-width:100%}
+table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0 1em}
+th,td{padding:2px 10px;border-bottom:1px solid #ddd;text-align:right;white-space:nowrap}
 th:first-child,td:first-child,td.l{text-align:left}th{background:#f0f0f0}
-.figs{display:flex;flex-wrap:wrap;gap:8px}.figs img{max-width:580px;border:1px solid #ddd}
-video{max-width:580px}
+td.l{white-space:normal;word-break:break-all}
+.figs{display:grid;grid-template-columns:repeat(auto-fill,minmax(520px,1fr));gap:8px}
+.figs img{width:100%;height:auto;border:1px solid #ddd}
+.traj img,.wide img{display:block;max-width:100%;height:auto;margin:0 auto 1.5em}
+details{margin:0.3em 0}summary{cursor:pointer;font-weight:bold;font-size:1.05em;
+padding:0.3em 0}
+.vids{display:flex;flex-wrap:wrap;gap:12px}.vids figure{margin:0}
+video{max-width:560px;width:100%;background:#000}figcaption{font-size:0.85em;color:#555}
 """
+
+#: Metrics whose figures are expanded in the HTML report (the others are collapsed).
+OPEN_METRICS: tuple[str, ...] = ("success", "collisions", "time_to_goal", "path_length", "spl",
+                                 "personal_space_compliance")
 
 
 def _img(fig: Any, alt: str) -> str:
@@ -164,44 +177,47 @@ def _img(fig: Any, alt: str) -> str:
 
 
 def _summary_html(rows: Sequence[SummaryRow]) -> str:
-    contestants = list(dict.fromkeys((r.contestant, r.stage) for r in rows))
-    metrics = list(dict.fromkeys(r.metric for r in rows))
-    cell = {(r.contestant, r.stage, r.metric): r for r in rows}
-    head = "".join(f"<th>{html.escape(c)}<br>{html.escape(s)}</th>" for c, s in contestants)
-    body = []
-    for m in metrics:
-        tds = []
-        for c, s in contestants:
-            r = cell.get((c, s, m))
-            if r is None:
-                tds.append("<td>–</td>")
-            else:
-                ci = f" ± {_fmt(r.ci)}" if math.isfinite(r.ci) else ""
-                tds.append(f"<td>{_fmt(r.mean)}{ci}</td>")
-        body.append(f"<tr><td>{html.escape(plots.metric_label(m))}</td>{''.join(tds)}</tr>")
-    return (f"<table><tr><th>metric</th>{head}</tr>{''.join(body)}</table>")
+    """One table per stage: a row per metric, a column per contestant (mean ± CI)."""
+    stages = list(dict.fromkeys(r.stage for r in rows))
+    out = []
+    for stage in stages:
+        sub = [r for r in rows if r.stage == stage]
+        contestants = list(dict.fromkeys(r.contestant for r in sub))
+        metrics = list(dict.fromkeys(r.metric for r in sub))
+        cell = {(r.contestant, r.metric): r for r in sub}
+        head = "".join(f"<th>{html.escape(c)}</th>" for c in contestants)
+        body = []
+        for m in metrics:
+            tds = []
+            for c in contestants:
+                r = cell.get((c, m))
+                if r is None:
+                    tds.append("<td>–</td>")
+                else:
+                    ci = f" ± {_fmt(r.ci)}" if math.isfinite(r.ci) else ""
+                    tds.append(f"<td>{_fmt(r.mean)}{ci}</td>")
+            body.append(f"<tr><td>{html.escape(plots.metric_label(m))}</td>{''.join(tds)}</tr>")
+        n = max((r.n for r in sub), default=0)
+        caption = f"<h3>{html.escape(stage)} <small>(n ≤ {n})</small></h3>" if stage else ""
+        out.append(f'{caption}<div class="scroll"><table><tr><th>metric</th>{head}</tr>'
+                   f"{''.join(body)}</table></div>")
+    return "".join(out)
 
 
-def _load_records(
-    cols: Mapping[str, np.ndarray], run_dir: Path, mask: np.ndarray, limit: int
-) -> list[EpisodeRecord]:
-    from arena.eval.io import load_record
+def _poster(video: Path) -> str:
+    """The video's first frame as a ``data:image/png`` URI ("" if it cannot be decoded)."""
+    try:
+        import io
 
-    out: list[EpisodeRecord] = []
-    if "record" not in cols:
-        return out
-    for rel in cols["record"][mask]:
-        if len(out) >= limit:
-            break
-        if not rel:
-            continue
-        p = run_dir / str(rel)
-        if p.is_file():
-            try:
-                out.append(load_record(p))
-            except Exception:
-                continue
-    return out
+        import imageio.v3 as iio
+        from PIL import Image
+
+        frame = next(iter(iio.imiter(video, extension=".mp4")))  # imageio-ffmpeg
+        buf = io.BytesIO()
+        Image.fromarray(np.asarray(frame)).save(buf, format="PNG", optimize=True)
+    except Exception:
+        return ""
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
 def episode_grid(record: EpisodeRecord) -> Any:
@@ -225,29 +241,75 @@ def episode_grid(record: EpisodeRecord) -> Any:
         return None
 
 
-def _grid_for(
-    grids: Any, records: Sequence[EpisodeRecord]
-) -> tuple[Any, Sequence[EpisodeRecord]]:
-    """The background grid for a trajectory plot and the records that belong on it.
+def _episode_grids(
+    grids: Any, episodes: Mapping[int, Sequence[tuple[str, EpisodeRecord]]]
+) -> dict[int, Any]:
+    """Each episode's background grid.
 
-    With ``grids=None`` the maps are rebuilt from the records' configs; records on another map
-    than the first (generated maps change per episode) are left out of that plot.
+    From ``grids`` (one grid, or ``map_name -> grid``) or, with ``grids=None``, rebuilt from
+    the episode's recorded config (:func:`episode_grid`; the map does not depend on the
+    contestant, so the first record of the episode is used).
     """
-    if not records:
-        return None, records
-    if isinstance(grids, Mapping):
-        return grids.get(records[0].meta.map_name), records
-    if grids is not None:
-        return grids, records
-    first = episode_grid(records[0])
-    if first is None:
-        return None, records
-    same = [records[0]]
-    for r in records[1:]:
-        g = episode_grid(r)
-        if g is not None and g == first:
-            same.append(r)
-    return first, same
+    out: dict[int, Any] = {}
+    for e, paths in episodes.items():
+        rec = paths[0][1]
+        if isinstance(grids, Mapping):
+            out[e] = grids.get(rec.meta.map_name)
+        elif grids is not None:
+            out[e] = grids
+        else:
+            out[e] = episode_grid(rec)
+    return out
+
+
+def stage_trajectories(
+    cols: Mapping[str, np.ndarray],
+    run_dir: Path,
+    stage: str | None,
+    *,
+    grids: Any = None,
+    max_episodes: int = 9,
+) -> tuple[list[plots.TrajectoryPanel], str]:
+    """The trajectory panels of one stage (see :func:`arena.eval.plots.trajectory_panels`).
+
+    Loads the records of the stage's first ``max_episodes`` episodes (every contestant; the
+    episode index is the table's ``episode`` column, else the record's), groups them by
+    episode and finds each episode's map: one panel if all episodes share a map, else one
+    panel per episode. ``stage=None`` = every row.
+    """
+    from arena.eval.io import load_record
+
+    if "record" not in cols:
+        return [], ""
+    n = len(cols["contestant"])
+    mask = np.ones(n, bool) if stage is None or "stage" not in cols else cols["stage"] == stage
+    idx = np.flatnonzero(mask)
+    ep_col = cols.get("episode")
+    keys = [int(ep_col[i]) if ep_col is not None else -1 for i in idx]
+    wanted = set(sorted(k for k in set(keys))[:max(1, max_episodes)]) if ep_col is not None \
+        else None
+    episodes: dict[int, list[tuple[str, EpisodeRecord]]] = {}
+    total: set[int] = set(keys)
+    for i, key in zip(idx, keys, strict=True):
+        if wanted is not None and key not in wanted:
+            continue
+        rel = cols["record"][i]
+        p = run_dir / str(rel)
+        if not rel or not p.is_file():
+            continue
+        try:
+            rec = load_record(p)
+        except Exception:
+            continue
+        e = key if ep_col is not None else int(rec.meta.episode)
+        if ep_col is None:
+            total.add(e)
+            if e not in episodes and len(episodes) >= max_episodes:
+                continue
+        episodes.setdefault(e, []).append((str(cols["contestant"][i]), rec))
+    total.discard(-1)
+    return plots.trajectory_panels(episodes, _episode_grids(grids, episodes),
+                                   max_panels=max_episodes, total=len(total))
 
 
 def write_report(
@@ -260,15 +322,16 @@ def write_report(
     title: str = "Arena benchmark report",
     kinds: Sequence[plots.PlotKind] = plots.PLOT_KINDS,
     metrics: Sequence[str] | None = None,
-    trajectories_per_group: int = 5,
+    trajectory_episodes: int = 9,
 ) -> Path:
     """Write one self-contained HTML report (no external assets).
 
     Contents: title, run info (run folder, manifest fields if ``run.json`` exists, episodes,
     contestants, stages, outcome counts), the summary table (mean ± 95 % CI), one figure per
-    metric and plot kind split by stage, the social radar chart, trajectory plots per contestant
-    and stage (records loaded from ``run_dir / table["record"]``), and the ``videos`` (MP4 files)
-    embedded as base64.
+    metric and plot kind split by stage, the social radar chart, one trajectory figure per stage
+    (small multiples, every contestant in its colour; records loaded from
+    ``run_dir / table["record"]``, see :func:`stage_trajectories`), and the ``videos`` (MP4
+    files) embedded as base64, each with its first frame as poster.
 
     Args:
         table: the results table.
@@ -281,7 +344,8 @@ def write_report(
         title: page title.
         kinds: plot kinds to draw per metric.
         metrics: metrics to plot and tabulate; ``None`` = all float non-key columns.
-        trajectories_per_group: episodes drawn per contestant × stage trajectory plot.
+        trajectory_episodes: most episodes per stage in the trajectory figure (one panel per
+            episode where each episode has its own map, else one shared panel).
 
     Returns:
         The HTML path.
@@ -324,39 +388,46 @@ def write_report(
     parts.append(_summary_html(summary_table(table, names)))
 
     by_stage = len(stages) > 1
-    for m in names:
-        if not np.isfinite(np.asarray(cols[m], np.float64)).any():
-            continue
+    plotted = [m for m in names if np.isfinite(np.asarray(cols[m], np.float64)).any()]
+    opened = {m for m in OPEN_METRICS if m in plotted} or set(plotted[:4])
+    if plotted:
+        parts.append("<h2>Metrics</h2><p>Per metric: mean with 95 % CI (bar), box, violin and "
+                     "strip plots by contestant and stage; click a metric to expand it.</p>")
+    for m in plotted:
         figs = [_img(plots.plot_metric(table, m, k, by_stage=by_stage), f"{m} {k}")
                 for k in kinds]
-        parts.append(f"<h3>{html.escape(plots.metric_label(m))}</h3>"
-                     f'<div class="figs">{"".join(figs)}</div>')
+        parts.append(f"<details{' open' if m in opened else ''}><summary>"
+                     f"{html.escape(plots.metric_label(m))}</summary>"
+                     f'<div class="figs">{"".join(figs)}</div></details>')
 
     social = [m for m in plots.SOCIAL_METRICS if m in cols and m in names]
     if social and len(contestants) > 1:
-        parts.append("<h2>Social metrics</h2>" + _img(plots.plot_radar(table, social), "radar"))
+        parts.append('<h2>Social metrics</h2><div class="wide">'
+                     + _img(plots.plot_radar(table, social), "radar") + "</div>")
 
     traj = []
-    for c in contestants:
-        for s in stages:
-            mask = cols["contestant"] == c
-            if "stage" in cols:
-                mask &= cols["stage"] == s
-            recs = _load_records(cols, run_dir, mask, trajectories_per_group)
-            if recs:
-                grid, shown = _grid_for(grids, recs)
-                fig = plots.plot_trajectories(shown, grid, title=f"{c} / {s}" if s else c)
-                traj.append(_img(fig, f"trajectories {c} {s}"))
+    for s in stages:
+        panels, note = stage_trajectories(cols, run_dir, s if "stage" in cols else None,
+                                          grids=grids, max_episodes=trajectory_episodes)
+        if panels:
+            fig = plots.plot_stage_trajectories(
+                panels, contestants, title=f"Trajectories: {s}" if s else "Trajectories",
+                note=note)
+            traj.append(_img(fig, f"trajectories {s}"))
     if traj:
-        parts.append(f'<h2>Trajectories</h2><div class="figs">{"".join(traj)}</div>')
+        parts.append(f'<h2>Trajectories</h2><div class="traj">{"".join(traj)}</div>')
 
     vids = []
     for v in videos:
         data = base64.b64encode(Path(v).read_bytes()).decode("ascii")
-        vids.append(f"<figure><video controls src=\"data:video/mp4;base64,{data}\"></video>"
-                    f"<figcaption>{html.escape(Path(v).name)}</figcaption></figure>")
+        poster = _poster(Path(v))
+        attr = f' poster="{poster}"' if poster else ""
+        vids.append(f'<figure><video controls preload="metadata"{attr} '
+                    f'src="data:video/mp4;base64,{data}"></video>'
+                    f"<figcaption>{html.escape('/'.join(Path(v).parts[-2:]))}</figcaption>"
+                    "</figure>")
     if vids:
-        parts.append(f'<h2>Videos</h2><div class="figs">{"".join(vids)}</div>')
+        parts.append(f'<h2>Videos</h2><div class="vids">{"".join(vids)}</div>')
 
     doc = (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"

@@ -111,3 +111,82 @@ def test_mean_ci_edge_cases():
     m, ci, n = plots.mean_ci(np.array([np.nan, 3.0, 3.0]))
     assert (m, ci, n) == (3.0, 0.0, 2)
     assert plots.mean_ci(np.array([]))[2] == 0
+
+
+# -- trajectory small multiples --------------------------------------------------------------------
+def _grid_with_block(col):
+    """A 20 x 20 grid (0.5 m cells, origin (0, 0)) with one occupied cell in row 10."""
+    data = np.zeros((20, 20), np.int8)
+    data[10, col] = 100
+    return OccupancyGrid(data, 0.5)
+
+
+def _stage(n_episodes, shared, contestants=("a", "b", "c")):
+    episodes = {e: [(c, _episode(collide=(c == "b" and e == 1), y=2.0 + e + 0.3 * k))
+                    for k, c in enumerate(contestants)] for e in range(n_episodes)}
+    grids = {e: _grid_with_block(3 if shared else e) for e in range(n_episodes)}
+    return episodes, grids
+
+
+def test_shared_map_gives_one_panel_with_every_path():
+    episodes, grids = _stage(4, shared=True)
+    panels, note = plots.trajectory_panels(episodes, grids)
+    assert len(panels) == 1 and len(panels[0].paths) == 4 * 3
+    assert "one map" in note and "per episode" not in note
+    fig = plots.plot_stage_trajectories(panels, ["a", "b", "c"], title="T", note=note)
+    assert len([ax for ax in fig.axes if ax.get_visible()]) == 1
+    assert len(fig.legends) == 1
+
+
+def test_per_episode_maps_give_one_panel_each_on_its_own_map():
+    episodes, grids = _stage(4, shared=False)
+    panels, note = plots.trajectory_panels(episodes, grids)
+    assert [p.title for p in panels] == [f"episode {e}" for e in range(4)]
+    assert note == "4 episodes, one map per episode"
+    fig = plots.plot_stage_trajectories(panels, ["a", "b", "c"])
+    axes = [ax for ax in fig.axes if ax.get_visible()]
+    assert len(axes) == 4 and len(fig.legends) == 1
+    for e, ax in enumerate(axes):
+        (img,) = ax.images
+        assert img.get_extent() == pytest.approx((0.0, 10.0, 0.0, 10.0))
+        dark = np.argwhere(np.asarray(img.get_array()) < 0.5)
+        assert dark.tolist() == [[10, e]]  # this episode's occupied cell
+        colors = {tuple(np.round(line.get_color(), 3)) if not isinstance(line.get_color(), str)
+                  else line.get_color() for line in ax.lines if len(line.get_xdata()) > 1}
+        assert colors == set(plots.contestant_colors(["a", "b", "c"]).values())
+
+
+def test_per_episode_panels_are_capped_and_the_note_says_which():
+    episodes, grids = _stage(12, shared=False, contestants=("a",))
+    panels, note = plots.trajectory_panels(episodes, grids, max_panels=9)
+    assert len(panels) == 9
+    assert note == "episodes 0–8 of 12 shown, one map per episode"
+    fig = plots.plot_stage_trajectories(panels, ["a"])
+    assert sum(ax.get_visible() for ax in fig.axes) == 9
+    _, note = plots.trajectory_panels({0: episodes[0], 1: episodes[1]}, grids, total=5)
+    assert note == "episodes 0–1 of 5 shown, one map per episode"
+
+
+def test_collision_markers_where_the_record_collides(tmp_path):
+    episodes, grids = _stage(2, shared=False)
+    panels, _ = plots.trajectory_panels(episodes, grids)
+    fig = plots.plot_stage_trajectories(panels, ["a", "b", "c"], path=tmp_path / "t.png")
+    _check_png(tmp_path / "t.png")
+    ax0, ax1 = fig.axes[:2]
+    assert not [c for c in ax0.collections if c.get_gid() == "collision"]
+    (marks,) = [c for c in ax1.collections if c.get_gid() == "collision"]
+    rec = dict(episodes[1])["b"]
+    hit = rec.pose[rec.collision_wall, :2]
+    np.testing.assert_allclose(marks.get_offsets(), hit)
+    texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert texts == ["a", "b", "c", "start", "goal", "collision"]
+
+
+def test_blank_panels_without_grids_and_ranges():
+    episodes, _ = _stage(2, shared=True)
+    panels, note = plots.trajectory_panels(episodes, {0: None, 1: None})
+    assert len(panels) == 1 and panels[0].grid is None and note == "2 episodes, one map"
+    fig = plots.plot_stage_trajectories(panels, ["a", "b", "c"])
+    assert not fig.axes[0].images
+    assert plots.trajectory_panels({}, {}) == ([], "")
+    assert plots.episode_ranges([0, 1, 2, 5, 7, 8]) == "0–2, 5, 7–8"

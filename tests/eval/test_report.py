@@ -83,8 +83,8 @@ def test_write_report_self_contained(tmp_path):
     srcs = re.findall(r'src="([^"]*)"', text)
     assert srcs and all(s.startswith("data:") for s in srcs)
     n_png = sum(s.startswith("data:image/png;base64,") for s in srcs)
-    # 7 metrics x 2 kinds + radar + 4 trajectory plots
-    assert n_png == 7 * 2 + 1 + 4
+    # 7 metrics x 2 kinds + radar + one trajectory figure per stage
+    assert n_png == 7 * 2 + 1 + 2
     assert any(s.startswith("data:video/mp4;base64,") for s in srcs)
     for c in CONTESTANTS:
         assert c in text
@@ -105,7 +105,7 @@ def test_main_reads_store(tmp_path, monkeypatch):
 def test_trajectory_maps_are_rebuilt_from_the_records(tmp_path):
     from arena.config.loader import load_config
     from arena.eval.io import load_record
-    from arena.eval.report import _grid_for, episode_grid
+    from arena.eval.report import episode_grid, stage_trajectories
     from arena.experiment import planning_grid, run_experiment
     from arena.tasks.generator import TaskGenerator
 
@@ -114,17 +114,24 @@ def test_trajectory_maps_are_rebuilt_from_the_records(tmp_path):
                                  "task.obstacles.dynamic=1", *extra])
         out, _ = run_experiment(cfg, tmp_path / name)
         recs = [load_record(out / f"episode_{i:03d}" / "episode.parquet") for i in range(2)]
-        return cfg, recs
+        cols = {"contestant": np.array(["x", "x"]), "stage": np.array(["s", "s"]),
+                "episode": np.array([0, 1]),
+                "record": np.array([f"{name}/episode_{i:03d}/episode.parquet" for i in range(2)])}
+        return cfg, recs, cols
 
-    cfg, recs = records([], "office")  # one world map, random obstacles per episode
+    cfg, recs, _ = records([], "office")  # one world map, random obstacles per episode
     expected = planning_grid(TaskGenerator.from_config(cfg).episode(1))
     assert episode_grid(recs[1]) == expected
     assert episode_grid(recs[0]) != expected  # the placed obstacles are part of the map drawn
-    _, recs = records(["task.obstacles.static=0"], "bare")  # the same map in both episodes
-    grid, shown = _grid_for(None, recs)
-    assert grid == episode_grid(recs[0]) and len(shown) == 2
-    _, recs = records(["map.type=barn", "map.width=12", "map.height=10",
-                       "task.robots.min_goal_distance=3",
-                       "task.modules=[{type: dynamic_map, episodes_per_map: 1}]"], "barn")
-    grid, shown = _grid_for(None, recs)
-    assert grid is not None and len(shown) == 1  # a new map per episode: one per plot
+    _, recs, cols = records(["task.obstacles.static=0"], "bare")  # the same map twice
+    panels, note = stage_trajectories(cols, tmp_path, "s")
+    assert len(panels) == 1 and len(panels[0].paths) == 2 and "one map" in note
+    assert panels[0].grid == episode_grid(recs[0])
+    _, recs, cols = records(["map.type=barn", "map.width=12", "map.height=10",
+                             "task.robots.min_goal_distance=3",
+                             "task.modules=[{type: dynamic_map, episodes_per_map: 1}]"], "barn")
+    panels, note = stage_trajectories(cols, tmp_path, "s")  # a new map per episode
+    assert [p.grid for p in panels] == [episode_grid(r) for r in recs]
+    assert panels[0].grid != panels[1].grid and "per episode" in note
+    panels, note = stage_trajectories(cols, tmp_path, "s", max_episodes=1)
+    assert len(panels) == 1 and note == "episodes 0 of 2 shown, one map"
