@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 ARGS   ?=
 
-.PHONY: run test lint bench clean
+.PHONY: run demo test lint bench screenshots clean
 
 $(PY):
 	$(PYTHON) -m venv $(VENV)
@@ -20,13 +20,19 @@ $(TEST_STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet -e ".[test]"
 	touch $@ $(STAMP)
 
-## run: create .venv, install Arena and run the main job on the embedded defaults
+## run: create .venv, install Arena and run the main job: the packaged quick benchmark
+## (4 planners x 8 episodes in 3 worlds with people + a corridor scenario) and its report
+RUN_DIR ?= runs/quick_$(shell date +%Y%m%d-%H%M%S)
 run: $(STAMP)
-	$(VENV)/bin/arena run $(ARGS)
+	$(VENV)/bin/arena bench quick --contest quick --workers 2 -o $(RUN_DIR) --report $(ARGS)
 
 ## test: install the test extras and run the test suite
 test: $(TEST_STAMP)
 	$(PY) -m pytest -n 2 -q
+
+## demo: one episode of the default experiment with a video (arena run)
+demo: $(STAMP)
+	$(VENV)/bin/arena run $(ARGS)
 
 lint: $(TEST_STAMP)
 	$(VENV)/bin/ruff check .
@@ -34,6 +40,11 @@ lint: $(TEST_STAMP)
 
 bench: $(STAMP)
 	$(PY) benchmarks/sim_step.py
+
+## screenshots: install Chromium (apt) and screenshot a report: make screenshots REPORT=runs/x/report/report.html
+screenshots:
+	bash tools/install_chromium.sh
+	$(PY) tools/screenshot_report.py $(REPORT) -o docs/images/report
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache

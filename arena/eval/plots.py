@@ -56,6 +56,9 @@ HIGHER_IS_BETTER: dict[str, bool] = {
     "clearance": True,
     "jerk": False,
     "roughness": False,
+    "cf_displacement_mean": False,
+    "cf_displacement_max": False,
+    "cf_people_displaced": False,
 }
 
 #: The social metrics shown on the radar chart (those present in the table are used).
@@ -67,6 +70,7 @@ SOCIAL_METRICS: tuple[str, ...] = (
     "group_space_intrusion",
     "induced_force",
     "time_seen_by_pedestrians",
+    "cf_displacement_mean",
 )
 
 _COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",

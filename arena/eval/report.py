@@ -168,12 +168,36 @@ video{max-width:560px;width:100%;background:#000}figcaption{font-size:0.85em;col
 
 #: Metrics whose figures are expanded in the HTML report (the others are collapsed).
 OPEN_METRICS: tuple[str, ...] = ("success", "collisions", "time_to_goal", "path_length", "spl",
-                                 "personal_space_compliance")
+                                 "personal_space_compliance", "cf_displacement_mean")
 
 
 def _img(fig: Any, alt: str) -> str:
     data = base64.b64encode(plots.figure_png(fig)).decode("ascii")
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
+
+
+def _metric_images(
+    table: Any, metric: str, kinds: Sequence[plots.PlotKind], by_stage: bool
+) -> list[str]:
+    """The ``<img>`` tags of one metric's plots (a top-level function: it runs in workers)."""
+    return [_img(plots.plot_metric(table, metric, k, by_stage=by_stage), f"{metric} {k}")
+            for k in kinds]
+
+
+def _all_metric_images(
+    table: Any, metrics: Sequence[str], kinds: Sequence[plots.PlotKind], by_stage: bool,
+    workers: int,
+) -> list[list[str]]:
+    """:func:`_metric_images` for every metric, in ``workers`` processes (1: in this one)."""
+    if workers <= 1 or len(metrics) < 2:
+        return [_metric_images(table, m, kinds, by_stage) for m in metrics]
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor
+
+    with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as pool:
+        futures = [pool.submit(_metric_images, table, m, list(kinds), by_stage)
+                   for m in metrics]
+        return [f.result() for f in futures]
 
 
 def _summary_html(rows: Sequence[SummaryRow]) -> str:
@@ -318,11 +342,12 @@ def write_report(
     out_html: str | Path,
     *,
     grids: Any = None,
-    videos: Sequence[str | Path] = (),
+    videos: Sequence[str | Path | tuple[str | Path, str]] = (),
     title: str = "Arena benchmark report",
     kinds: Sequence[plots.PlotKind] = plots.PLOT_KINDS,
     metrics: Sequence[str] | None = None,
     trajectory_episodes: int = 9,
+    workers: int = 1,
 ) -> Path:
     """Write one self-contained HTML report (no external assets).
 
@@ -340,12 +365,14 @@ def write_report(
         grids: an :class:`~arena.maps.grid.OccupancyGrid` for every trajectory plot, or a mapping
             ``map_name -> grid``; ``None`` = rebuild each episode's map from its recorded config
             (:func:`episode_grid`; blank background if that fails).
-        videos: MP4 files to embed.
+        videos: MP4 files to embed, each a path or a ``(path, caption)`` pair (default
+            caption: the file's folder and name).
         title: page title.
         kinds: plot kinds to draw per metric.
         metrics: metrics to plot and tabulate; ``None`` = all float non-key columns.
         trajectory_episodes: most episodes per stage in the trajectory figure (one panel per
             episode where each episode has its own map, else one shared panel).
+        workers: processes drawing the metric figures.
 
     Returns:
         The HTML path.
@@ -393,9 +420,8 @@ def write_report(
     if plotted:
         parts.append("<h2>Metrics</h2><p>Per metric: mean with 95 % CI (bar), box, violin and "
                      "strip plots by contestant and stage; click a metric to expand it.</p>")
-    for m in plotted:
-        figs = [_img(plots.plot_metric(table, m, k, by_stage=by_stage), f"{m} {k}")
-                for k in kinds]
+    images = _all_metric_images(table, plotted, kinds, by_stage, workers)
+    for m, figs in zip(plotted, images, strict=True):
         parts.append(f"<details{' open' if m in opened else ''}><summary>"
                      f"{html.escape(plots.metric_label(m))}</summary>"
                      f'<div class="figs">{"".join(figs)}</div></details>')
@@ -419,13 +445,14 @@ def write_report(
 
     vids = []
     for v in videos:
-        data = base64.b64encode(Path(v).read_bytes()).decode("ascii")
-        poster = _poster(Path(v))
+        path, caption = (Path(v[0]), v[1]) if isinstance(v, tuple) else (
+            Path(v), "/".join(Path(v).parts[-2:]))
+        data = base64.b64encode(path.read_bytes()).decode("ascii")
+        poster = _poster(path)
         attr = f' poster="{poster}"' if poster else ""
         vids.append(f'<figure><video controls preload="metadata"{attr} '
                     f'src="data:video/mp4;base64,{data}"></video>'
-                    f"<figcaption>{html.escape('/'.join(Path(v).parts[-2:]))}</figcaption>"
-                    "</figure>")
+                    f"<figcaption>{html.escape(caption)}</figcaption></figure>")
     if vids:
         parts.append(f'<h2>Videos</h2><div class="vids">{"".join(vids)}</div>')
 
@@ -442,7 +469,9 @@ def main(
     out: str | Path | None = None,
     *,
     grids: Any = None,
-    videos: Sequence[str | Path] = (),
+    videos: Sequence[str | Path | tuple[str | Path, str]] = (),
+    video_episodes: int = 1,
+    workers: int = 1,
 ) -> dict[str, Path]:
     """``arena report RUN``: load the run's results and write ``report.html`` and the tables.
 
@@ -450,7 +479,11 @@ def main(
         run_dir: a benchmark run folder (see :mod:`arena.eval.store`).
         out: output folder; default ``<run_dir>/report``.
         grids: occupancy grid(s) for the trajectory plots (see :func:`write_report`).
-        videos: MP4 files to embed.
+        videos: further MP4 files to embed (see :func:`write_report`).
+        video_episodes: episodes re-simulated as videos for every contestant, chosen where the
+            contestants differ most (:func:`arena.eval.replay.pick_episodes`); written under
+            ``<out>/videos``.
+        workers: processes drawing the figures and rendering the videos.
 
     Returns:
         ``{"html": ..., "csv": ..., "tex": ...}`` paths.
@@ -461,7 +494,17 @@ def main(
     dest = Path(out) if out is not None else run / "report"
     table = load_results(run)
     csv_path, tex_path = write_tables(table, dest)
-    html_path = write_report(table, run, dest / "report.html", grids=grids, videos=videos)
+    clips: list[str | Path | tuple[str | Path, str]] = []
+    if video_episodes > 0:
+        from arena.eval.replay import episode_videos
+
+        for v in episode_videos(run, table, dest / "videos", count=video_episodes,
+                                workers=workers):
+            note = "" if v.matches_record else " (re-simulation differs from the record)"
+            clips.append((v.path, v.caption + note))
+    clips.extend(videos)
+    html_path = write_report(table, run, dest / "report.html", grids=grids, videos=clips,
+                             workers=workers)
     return {"html": html_path, "csv": csv_path, "tex": tex_path}
 
 

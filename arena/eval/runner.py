@@ -17,6 +17,7 @@ message in ``error``; the run goes on.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 import traceback
@@ -117,21 +118,9 @@ def _nan_metrics() -> dict[str, float]:
     return {n: math.nan for n in METRICS.names()}
 
 
-def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
-    """Run one job; return its results row (ids, outcome, metrics, figures) and its record.
-
-    Never raises for a failing episode: any exception becomes outcome ``error`` with
-    ``"<ExceptionType>: message"`` in ``error`` (and NaN metrics when no record was made).
-    """
-    import json
-
-    import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
-    from arena.eval.metrics import compute_metrics
-    from arena.experiment import run_episode
-    from arena.sim.backend import BACKENDS
-
-    t0 = time.perf_counter()
-    row: dict[str, Any] = {
+def _base_row(job: Job) -> dict[str, Any]:
+    """A job's results row before it ran: its ids, outcome ``error``, no figures."""
+    return {
         "contestant": job.contestant,
         "local_planner": job.local_planner,
         "inter_planner": job.inter_planner,
@@ -147,6 +136,32 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
         "wall_time": 0.0,
         "error": "",
     }
+
+
+def _error_result(job: Job, error: str) -> tuple[dict[str, Any], EpisodeRecord | None]:
+    """The result of a job that failed outside :func:`run_job` (e.g. its worker died)."""
+    row = _base_row(job)
+    row["error"] = error
+    for name, value in _nan_metrics().items():
+        row.setdefault(name, value)
+    return row, None
+
+
+def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
+    """Run one job; return its results row (ids, outcome, metrics, figures) and its record.
+
+    Never raises for a failing episode: any exception becomes outcome ``error`` with
+    ``"<ExceptionType>: message"`` in ``error`` (and NaN metrics when no record was made).
+    """
+    import json
+
+    import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
+    from arena.eval.metrics import compute_metrics
+    from arena.experiment import run_episode
+    from arena.sim.backend import BACKENDS
+
+    t0 = time.perf_counter()
+    row = _base_row(job)
     record = None
     metrics = _nan_metrics()
     try:
@@ -195,6 +210,7 @@ def run_benchmark(
     scale: float = 1.0,
     progress: bool | ProgressFn | None = None,
     backend: str = "process",
+    ray_address: str | None = None,
 ) -> Path:
     """Run (or resume) a benchmark into ``run_dir``; return the run folder.
 
@@ -204,13 +220,17 @@ def run_benchmark(
         contest: packaged contest name, contest file or a loaded :class:`ContestFile`.
         run_dir: the run folder (created); results land as in :mod:`arena.eval.store`.
         base_cfg: the experiment every stage derives from (its ``seed`` is the run seed).
-        workers: parallel worker processes (1 = in this process).
+        workers: parallel worker processes (1 = in this process); with ``backend="ray"``, the
+            number of tasks run at once (and the CPUs of the local Ray it starts).
         resume: continue the run in ``run_dir``: skip its committed episodes. The suite,
             contest, seed and scale must be the run's.
         scale: factor on every stage's episode count.
         progress: ``True`` shows a rich progress bar with ETA; a callable gets
             ``(done, total, row)`` after every committed episode.
-        backend: ``"process"`` (``concurrent.futures``) or ``"ray"`` (needs ``ray``).
+        backend: ``"process"`` (``concurrent.futures``) or ``"ray"`` (needs ``ray``). The
+            backend is not part of the run's settings: a run resumes with either.
+        ray_address: with ``backend="ray"``: ``None`` starts a local Ray (shut down at the end)
+            unless one is already initialized; ``"auto"`` or an address connects to a cluster.
 
     Raises:
         ArenaError: a bad suite/contest, ``run_dir`` holding a run without ``resume``, a resume
@@ -257,13 +277,13 @@ def run_benchmark(
     done = completed(run)
     todo = [j for j in jobs if j.key not in done]
     total = len(jobs)
-    _execute(run, todo, total, total - len(todo), workers, progress, backend)
+    _execute(run, todo, total, total - len(todo), workers, progress, backend, ray_address)
     return run
 
 
 def _execute(
     run: Path, todo: Sequence[Job], total: int, start: int, workers: int,
-    progress: bool | ProgressFn | None, backend: str,
+    progress: bool | ProgressFn | None, backend: str, ray_address: str | None = None,
 ) -> None:
     bar: Any = None
     task: Any = None
@@ -300,7 +320,7 @@ def _execute(
 
     try:
         if backend == "ray":
-            _execute_ray(todo, workers, commit)
+            _execute_ray(todo, workers, commit, address=ray_address)
         elif workers == 1 or len(todo) <= 1:
             for job in todo:
                 commit(run_job(job))
@@ -324,21 +344,96 @@ def _execute(
             bar.stop()
 
 
-def _execute_ray(todo: Sequence[Job], workers: int, commit: Callable[[Any], None]) -> None:
-    """Run the jobs as ray tasks (at most ``workers`` at once); commit in the caller."""
+def _ray_run_job(config: dict[str, Any], contestant: str, local_planner: str,
+                 inter_planner: str, stage: str, episode: int,
+                 ) -> tuple[dict[str, Any], EpisodeRecord | None]:
+    """:func:`run_job` as a ray task: the config comes as one shared object-store ref."""
+    return run_job(Job(contestant, local_planner, inter_planner, stage, episode, config))
+
+
+def _ray_error(e: BaseException) -> str:
+    """``"<ExceptionType>: message"`` of a failed ray task (the task's own exception if any)."""
+    cause = getattr(e, "cause", None)
+    err = cause if isinstance(cause, BaseException) else e
+    lines = str(err).strip().splitlines()
+    return f"{type(err).__name__}: {lines[0] if lines else ''}".rstrip(": ")
+
+
+def _ray_init(ray: Any, workers: int, address: str | None) -> str | None:
+    """Start (``address=None``) or connect to Ray, quietly; return the temp dir we made."""
+    import logging
+    import os
+    import tempfile
+
+    os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+    kwargs: dict[str, Any] = {
+        "include_dashboard": False, "log_to_driver": False, "logging_level": logging.ERROR,
+    }
+    if address is not None:
+        ray.init(address=address, **kwargs)
+        return None
+    # A short private folder: ray's unix sockets live there (path limit ~107 chars), and a
+    # CI's TMPDIR may be long or shared; RAY_TMPDIR picks another parent.
+    parent = os.environ.get("RAY_TMPDIR") or ("/tmp" if os.path.isdir("/tmp") else None)
+    temp_dir = tempfile.mkdtemp(prefix="arena_ray_", dir=parent)
+    try:
+        ray.init(num_cpus=workers, _temp_dir=temp_dir, **kwargs)
+    except BaseException:
+        import shutil
+
+        shutil.rmtree(temp_dir, ignore_errors=True)
+        raise
+    return temp_dir
+
+
+def _execute_ray(todo: Sequence[Job], workers: int, commit: Callable[[Any], None],
+                 *, address: str | None = None) -> None:
+    """Run the jobs as ray tasks (at most ``workers`` at once); commit in the caller.
+
+    Starts a local Ray (``address=None``) or connects to ``address`` unless Ray is already
+    initialized, and shuts it down afterwards only if it did. A task that fails outside
+    :func:`run_job` (its worker died, its arguments did not arrive) becomes an ``error`` row.
+    """
     import ray
 
-    if not ray.is_initialized():
-        ray.init(num_cpus=workers, include_dashboard=False)
-    remote = ray.remote(run_job)
-    queue = list(todo)
-    pending: list[Any] = []
-    while queue or pending:
-        while queue and len(pending) < workers:
-            pending.append(remote.remote(queue.pop(0)))
-        ready, pending = ray.wait(pending, num_returns=1)
-        for ref in ready:
-            commit(ray.get(ref))
+    started = not ray.is_initialized()
+    temp_dir = _ray_init(ray, workers, address) if started else None
+    try:
+        remote = ray.remote(num_cpus=1, max_retries=0)(_ray_run_job)
+        configs: dict[int, Any] = {}  # one object-store copy per distinct config
+        queue = list(todo)
+        queue.reverse()
+        pending: dict[Any, Job] = {}
+        try:
+            while queue or pending:
+                while queue and len(pending) < workers:
+                    job = queue.pop()
+                    if id(job.config) not in configs:
+                        configs[id(job.config)] = ray.put(job.config)
+                    ref = remote.remote(configs[id(job.config)], job.contestant,
+                                        job.local_planner, job.inter_planner, job.stage,
+                                        job.episode)
+                    pending[ref] = job
+                ready, _ = ray.wait(list(pending), num_returns=1)
+                for ref in ready:
+                    job = pending.pop(ref)
+                    try:
+                        result = ray.get(ref)
+                    except Exception as e:  # the task failed outside run_job
+                        result = _error_result(job, _ray_error(e))
+                    commit(result)
+        except BaseException:  # Ctrl-C or a failed commit: drop the running tasks, stop now
+            for ref in pending:  # (not force=True: that kills the workers, maybe a cluster's)
+                with contextlib.suppress(Exception):
+                    ray.cancel(ref)
+            raise
+    finally:
+        if started:
+            ray.shutdown()
+            if temp_dir is not None:
+                import shutil
+
+                shutil.rmtree(temp_dir, ignore_errors=True)
 
 
 __all__ = ["Job", "load_results", "plan_jobs", "run_benchmark", "run_job"]

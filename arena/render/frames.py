@@ -85,7 +85,8 @@ class FrameRenderer:
         title: text shown at the top right of every frame.
         margin_m: extra space around the map and obstacles (m).
         trail_length: how many past positions a recorded trail keeps.
-        legend: draw the pedestrian social-state colour legend (bottom right).
+        legend: draw the pedestrian social-state colour legend (bottom right, in its own
+            column right of the map; the frame is then at least as tall as the legend).
 
     Raises:
         ConfigError: ``width_px`` is too small or ``margin_m`` negative.
@@ -124,8 +125,15 @@ class FrameRenderer:
             xmin, ymin = min(xmin, float(poly[:, 0].min())), min(ymin, float(poly[:, 1].min()))
             xmax, ymax = max(xmax, float(poly[:, 0].max())), max(ymax, float(poly[:, 1].max()))
         xmin, ymin, xmax, ymax = xmin - margin_m, ymin - margin_m, xmax + margin_m, ymax + margin_m
-        self.scale = float(width_px) / (xmax - xmin)
+        # The legend gets its own column right of the map (it must never hide the map, e.g. the
+        # goal at the end of a long corridor), and the frame is tall enough for it and the title.
+        legend_w, legend_h = _legend_extent(width_px) if legend else (0.0, 0.0)
+        self.scale = (float(width_px) - legend_w) / (xmax - xmin)
+        if title or legend:  # a strip above the map for the title and the time line
+            ymax += _title_height(width_px) / self.scale
         height_px = max(2, math.ceil((ymax - ymin) * self.scale - 1e-6))
+        if legend:
+            height_px = max(height_px, math.ceil(legend_h + _title_height(width_px)))
         height_px += height_px % 2
         self.width_px, self.height_px = int(width_px), int(height_px)
 
@@ -315,8 +323,7 @@ class FrameRenderer:
         )
 
     def _font_size(self) -> float:
-        # Scales with the frame so that text stays readable at 400 px and not huge at 1600 px.
-        return float(np.clip(self.width_px / 75.0, 7.0, 16.0))
+        return _font_size(self.width_px)
 
     def _text_box(self) -> dict[str, object]:
         return {
@@ -651,6 +658,23 @@ class FrameRenderer:
         self._robots.set_edgecolors(edges if edges else "none")
         self._robots.set_linewidths(widths if widths else [0.0])
         self._robot_heading.set_segments(heads)
+
+
+def _font_size(width_px: float) -> float:
+    """Font size (pt): readable at 400 px wide, not huge at 1600 px."""
+    return float(np.clip(width_px / 75.0, 7.0, 16.0))
+
+
+def _legend_extent(width_px: float) -> tuple[float, float]:
+    """``(width, height)`` px of the social-state legend box plus its 8 px margins."""
+    fs = _font_size(width_px) * 0.8
+    line = fs * 1.45 / 72.0 * _DPI
+    return 16.0 + fs * 7.5 / 72.0 * _DPI, 16.0 + line * len(style.AGENT_STATE_NAMES)
+
+
+def _title_height(width_px: float) -> float:
+    """Pixels taken by the title line at the top (with its box and margin)."""
+    return 16.0 + _font_size(width_px) * 1.45 / 72.0 * _DPI
 
 
 def _rgba_to_rgb(rgba: NDArray[np.uint8]) -> NDArray[np.uint8]:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 import os
@@ -245,10 +244,10 @@ def test_store_ignores_uncommitted_files(tmp_path: Path) -> None:
         commit_episode(run, {**row, "contestant": "a/b"}, None)
 
 
-@pytest.mark.skipif(importlib.util.find_spec("ray") is not None, reason="ray is installed")
-def test_ray_backend_without_ray_is_a_clear_error(files: tuple[Path, Path],
-                                                  tmp_path: Path) -> None:
+def test_ray_backend_without_ray_is_a_clear_error(files: tuple[Path, Path], tmp_path: Path,
+                                                  monkeypatch: pytest.MonkeyPatch) -> None:
     suite, contest = files
+    monkeypatch.setitem(sys.modules, "ray", None)  # `import ray` fails, installed or not
     with pytest.raises(ArenaError, match="ray package"):
         run_benchmark(suite, contest, tmp_path / "run", backend="ray")
 
@@ -268,11 +267,15 @@ def test_cli_bench(files: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest
         out = capsys.readouterr()
         return code, out.out, out.err
 
+    monkeypatch.setattr(cli.console, "width", 200)
     code, out, err = call(str(suite), "--contest", str(contest), "-o", str(run), "--scale",
-                          "0.5", "--no-progress")
+                          "0.5", "--no-progress", "--report")
     assert code == 0, err
     assert "pure_pursuit" in out and "dwa" in out and "crowd" in out
+    assert "mean over all episodes" in out and "success per stage" in out
     assert f"run folder: {run}" in out.replace("\n", "")
+    assert f"html:  {run / 'report' / 'report.html'}" in out
+    assert (run / "report" / "report.html").is_file()
     assert load_results(run).num_rows == 4
     code, out, err = call(str(suite), "--resume", str(run), "--no-progress")  # the run's settings
     assert code == 0, err
@@ -293,6 +296,8 @@ def test_cli_report(reference: pa.Table, files: tuple[Path, Path], tmp_path: Pat
     html = (run / "report" / "report.html").read_text()
     assert "report.html" in out and 'src="http' not in html
     assert "pure_pursuit" in html and "data:image/png;base64," in html
+    # one re-simulated episode per contestant, by default
+    assert html.count("data:video/mp4;base64,") == 2 and "episode " in html
     assert (run / "report" / "summary.tex").read_text().count("\\toprule") == 1
     monkeypatch.setattr(sys, "argv", ["arena", "report", str(tmp_path)])
     with pytest.raises(SystemExit) as e:

@@ -123,14 +123,16 @@ def test_stage_experiment_equals_stage_inside_suite():
 
 
 def test_scale_episodes():
-    assert load_suite("paper").total_episodes == 150
-    assert load_suite("paper", scale_episodes=0.1).episode_counts == [10, 1, 1, 1, 1, 1]
-    assert _gen("quick", scale=2.0).num_episodes == 12
+    assert load_suite("paper").total_episodes == 160
+    assert load_suite("paper", scale_episodes=0.1).episode_counts == [10, 1, 1, 1, 1, 1, 1]
+    assert _gen("quick", scale=2.0).num_episodes == 16
 
 
 def test_quick_suite_and_first_episode_of_every_paper_stage():
     eps = list(_gen("quick").episodes())
-    assert len(eps) == 6 and {e.label for e in eps} == {"random", "canteen", "corridor_scenario"}
+    assert len(eps) == 8
+    assert {e.label for e in eps} == {"random", "canteen", "office", "corridor_scenario"}
+    assert all(len(e.agents) >= 3 for e in eps if e.label != "corridor_scenario")
     gen = _gen("paper")
     suite = gen.modules[0].suite
     start = 0
@@ -144,7 +146,7 @@ def test_quick_suite_and_first_episode_of_every_paper_stage():
 @pytest.mark.slow
 def test_every_paper_episode_is_valid():
     eps = list(_gen("paper").episodes())
-    assert len(eps) == 150
+    assert len(eps) == 160
     assert max(len(e.agents) for e in eps[:100]) <= 30
 
 
