@@ -106,6 +106,10 @@ def unique_in_order(values: NDArray[Any]) -> list[str]:
     return [str(values[i]) for i in np.sort(idx)]
 
 
+#: Metric-name words written as acronyms in labels ("spl" → "SPL", "cf_..." → "CF ...").
+_ACRONYMS = {"spl": "SPL", "cf": "CF", "ttc": "TTC"}
+
+
 def metric_label(name: str) -> str:
     """Axis label for a metric, e.g. ``"Time to goal [s]"`` (unit from the metric registry)."""
     unit = ""
@@ -116,7 +120,8 @@ def metric_label(name: str) -> str:
             unit = METRICS.get(name).unit
     except Exception:
         unit = ""
-    text = name.replace("_", " ")
+    words = [_ACRONYMS.get(w, w) for w in name.split("_")]
+    text = " ".join(words)
     text = text[:1].upper() + text[1:]
     unit = {"m/s^2": "m/s²", "m/s^3": "m/s³"}.get(unit, unit)
     return f"{text} [{unit}]" if unit and unit not in ("1", "-") else (

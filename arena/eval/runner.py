@@ -239,6 +239,8 @@ def run_benchmark(
     base_cfg = base_cfg or ExperimentConfig()
     if workers < 1:
         raise ArenaError(f"workers must be >= 1, got {workers}")
+    import arena.plugins  # noqa: F401  (fills the registries: map sources, planners, ...)
+
     if backend not in ("process", "ray"):
         raise ArenaError(f"unknown backend {backend!r}; expected 'process' or 'ray'")
     if backend == "ray":

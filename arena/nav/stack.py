@@ -690,6 +690,11 @@ class NavigationStack:
                 if obs.goal_yaw_tolerance is not None
                 else self.goal_tolerance_yaw
             ),
+            goal_xy_tolerance=(
+                obs.goal_xy_tolerance
+                if obs.goal_xy_tolerance is not None
+                else self.goal_tolerance_xy
+            ),
             pedestrians=(
                 _ped_array(pedestrians)
                 if pedestrians is not None and len(pedestrians) and not np.size(obs.pedestrians)

@@ -180,3 +180,22 @@ def test_reaches_goals_in_an_empty_room(name: str, tmp_path: Path) -> None:
     _, results = run_experiment(cfg, tmp_path)
     assert [r.outcome for r in results] == ["success"] * 5
     assert all(r.collisions == 0 for r in results)
+
+
+@pytest.mark.parametrize("name", ["dwa", "teb", "pure_pursuit", "social_force", "orca"])
+def test_inside_the_stack_tolerance_a_wrong_heading_is_turned_not_circled(name):
+    import dataclasses
+
+    from arena.core.types import Pose2D
+    from arena.nav.local_planners import LOCAL_PLANNERS
+    from tests.nav.planner_kit import line, obs
+
+    path = line(0.0, 3.0)
+    goal = Pose2D(3.0, 0.0, math.pi / 2)  # the goal wants the robot facing +y
+    # 0.15 m short of the goal, facing +x, at rest; the stack accepts 0.27 m and 30°.
+    o = dataclasses.replace(obs([2.85, 0.0, 0.0], path), goal=goal,
+                            goal_yaw_tolerance=math.radians(30), goal_xy_tolerance=0.27)
+    cmd = LOCAL_PLANNERS.build({"type": name}).compute(o)
+    assert abs(cmd[0]) < 1e-9 and cmd[2] > 0.1, cmd  # turn left on the spot
+    far = dataclasses.replace(o, goal_xy_tolerance=0.1)  # outside: still driving to the goal
+    assert LOCAL_PLANNERS.build({"type": name}).compute(far)[0] > 0

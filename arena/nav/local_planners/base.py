@@ -60,6 +60,9 @@ class LocalObservation:
         goal_yaw_tolerance: heading error (rad) the navigation stack accepts at the goal, or
             ``None`` when the goal heading does not matter. Planners that can turn the robot on
             the spot align it to the goal's ``theta`` when this is set.
+        goal_xy_tolerance: distance (m) to the goal the navigation stack accepts as arrived, or
+            ``None``. With a goal heading to meet, planners that can turn on the spot start
+            aligning within this distance (see :func:`~.path_tracking.at_goal`).
         pedestrians: ``(n, 4)`` known pedestrians ``[x, y, vx, vy]`` (m, m/s, world frame) that
             the stack passes on (empty when it has none); human-aware planners use them.
         costmap: the navigation stack's rolling local costmap (``costmap_2d`` costs, world
@@ -80,6 +83,7 @@ class LocalObservation:
     time: float = 0.0
     kinematics: str | None = None
     goal_yaw_tolerance: float | None = None
+    goal_xy_tolerance: float | None = None
     pedestrians: NDArray[np.float64] = field(default_factory=_empty_peds)
     costmap: Costmap | None = None
 

@@ -64,6 +64,7 @@ from arena.nav.local_planners.base import (
 )
 from arena.nav.local_planners.path_tracking import (
     PathTracker,
+    at_goal,
     finish_command,
     goal_command,
     to_robot_frame,
@@ -260,7 +261,7 @@ class DWAPlanner:
         s = tr.track(path, pose[:2])
         d_end = float(np.hypot(*(path[-1] - pose[:2])))
         car = obs.drive == "ackermann" or lim.min_turning_radius > 0
-        if d_end <= p.goal_tolerance:
+        if at_goal(obs, d_end, p.goal_tolerance):
             return goal_command(obs, p.heading_gain, p.goal_yaw_tolerance)
 
         samples = self.samples(obs)

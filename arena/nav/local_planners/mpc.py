@@ -74,6 +74,7 @@ from arena.nav.local_planners.base import (
 )
 from arena.nav.local_planners.path_tracking import (
     PathTracker,
+    at_goal,
     cluster_points,
     finish_command,
     free_distance,
@@ -269,7 +270,7 @@ class MPCPlanner:
         tr = self._tracker
         s0 = tr.track(path, pose[:2])
         d_end = float(np.hypot(*(path[-1] - pose[:2])))
-        if d_end <= p.goal_tolerance:
+        if at_goal(obs, d_end, p.goal_tolerance):
             self._warm = None
             return goal_command(obs, p.heading_gain, p.goal_yaw_tolerance)
 

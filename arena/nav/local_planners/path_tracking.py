@@ -225,6 +225,22 @@ def finish_command(
     return out
 
 
+def at_goal(obs: LocalObservation, d_end: float, goal_tolerance: float) -> bool:
+    """Whether a planner is in its goal phase (brake, then align the heading if asked).
+
+    True within the planner's own ``goal_tolerance`` (m) of the path end; and, when the stack
+    asks for a goal heading and the robot can turn on the spot, already within 0.8 × the stack's
+    ``goal_xy_tolerance``: turning there meets the goal, while chasing the last centimetres at a
+    wrong heading made DWA circle around the goal for seconds.
+    """
+    if d_end <= goal_tolerance:
+        return True
+    xy = obs.goal_xy_tolerance
+    car = obs.drive == "ackermann" or obs.limits.min_turning_radius > 0
+    return (obs.goal_yaw_tolerance is not None and xy is not None and not car
+            and d_end <= 0.8 * xy)
+
+
 def goal_command(
     obs: LocalObservation, heading_gain: float, yaw_tolerance: float
 ) -> NDArray[np.float64]:

@@ -73,6 +73,7 @@ from arena.nav.local_planners.base import (
     limit_command,
     stopping_speed,
 )
+from arena.nav.local_planners.path_tracking import at_goal
 
 # Below this |curvature| (1/m) an arc is treated as a straight line (radius > 1 km).
 _STRAIGHT = 1e-3
@@ -298,7 +299,7 @@ class PurePursuitPlanner:
         s, total = self._track(path, xy)
         end = path[-1]
         d_end = float(np.hypot(*(end - xy)))
-        if d_end <= p.goal_tolerance:
+        if at_goal(obs, d_end, p.goal_tolerance):
             self._rotating = False
             cmd = np.zeros(3)
             want = obs.goal_yaw_tolerance

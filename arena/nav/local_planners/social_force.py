@@ -53,6 +53,7 @@ from arena.nav.local_planners.base import (
 from arena.nav.local_planners.path_tracking import (
     PathTracker,
     TrackingParams,
+    at_goal,
     cluster_points,
     finish_command,
     free_distance,
@@ -233,7 +234,7 @@ class SocialForcePlanner:
         p = self.params
         lim = obs.limits
         target, d_goal, d_end = lookahead_target(self._tracker, obs, p.lookahead)
-        if d_end <= p.goal_tolerance:
+        if at_goal(obs, d_end, p.goal_tolerance):
             return goal_command(obs, p.heading_gain, p.goal_yaw_tolerance)
         decel = p.decel_fraction * lim.acc_x
         v_top = min(lim.vx_max, p.max_speed) if p.max_speed is not None else lim.vx_max

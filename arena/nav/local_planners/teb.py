@@ -72,6 +72,7 @@ from arena.nav.local_planners.base import (
 )
 from arena.nav.local_planners.path_tracking import (
     PathTracker,
+    at_goal,
     cluster_points,
     finish_command,
     free_distance,
@@ -583,7 +584,7 @@ class TEBPlanner:
             drive = "ackermann"
         elif drive == "omni" and not lim.holonomic:
             drive = "diff_drive"
-        if d_end <= p.goal_tolerance:
+        if at_goal(obs, d_end, p.goal_tolerance):
             self.band = None
             return goal_command(obs, p.heading_gain, p.goal_yaw_tolerance)
 
