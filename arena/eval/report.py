@@ -229,7 +229,14 @@ def _summary_html(rows: Sequence[SummaryRow]) -> str:
 
 
 def _poster(video: Path) -> str:
-    """The video's first frame as a ``data:image/png`` URI ("" if it cannot be decoded)."""
+    """The poster of a video as a ``data:image/png`` URI ("" if there is none).
+
+    The episode's last frame (``final.png`` beside the video, written by ``run_episode``: it
+    shows the whole trajectory and the outcome), else the video's first frame.
+    """
+    final = video.with_name("final.png")
+    if final.is_file():
+        return "data:image/png;base64," + base64.b64encode(final.read_bytes()).decode("ascii")
     try:
         import io
 
