@@ -1,0 +1,365 @@
+"""numba kernels of :class:`~arena.sim.batch.BatchSim`: lidar, crowd and contacts of many worlds.
+
+Every kernel runs ``prange`` over worlds and does each world's work serially, reading only that
+world's slices, so a world's result never depends on the other worlds (nor on the thread count).
+
+Per-world static data is packed as follows (``N`` worlds):
+
+* distance maps: one flat float32 buffer; world ``i``'s ``(h_i, w_i)`` map in cells (0 marks a
+  blocking cell, as :class:`~arena.sensors.lidar2d.Lidar2D` stores it) starts at ``offs[i]``;
+* obstacle edges: ``(N, S, 2)`` padded arrays with ``seg_n[i]`` valid rows and ``seg_owner``
+  the obstacle each edge belongs to (an obstacle's edges are consecutive and closed);
+* pedestrians: ``(N, P, ...)`` padded arrays with ``ped_n[i]`` valid rows.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+from numpy.typing import NDArray
+
+from arena.sensors.lidar2d import _scan_kernel
+
+F64 = NDArray[np.float64]
+F32 = NDArray[np.float32]
+I64 = NDArray[np.int64]
+B1 = NDArray[np.bool_]
+
+SQRT2 = math.sqrt(2.0)
+
+#: Collision kinds reported per world (the first that applies, in this order).
+KIND_NONE = 0
+KIND_WALL = 1
+KIND_OBSTACLE = 2
+KIND_PEDESTRIAN = 3
+
+# Indices into the crowd parameter vector (see ``BatchCrowdParams.as_array``).
+P_TAU, P_GOAL_R, P_A_PED, P_B_PED, P_A_WALL, P_B_WALL, P_A_ROB, P_B_ROB, P_CUTOFF, P_VFAC = range(
+    10
+)
+
+
+@njit(cache=True)
+def _world_map(dist_flat: F32, offs: I64, shapes: I64, i: int) -> F32:
+    """World ``i``'s ``(h, w)`` distance map (cells), a C-contiguous view of the flat buffer."""
+    h = shapes[i, 0]
+    w = shapes[i, 1]
+    return dist_flat[offs[i] : offs[i] + h * w].reshape((h, w))
+
+
+# ------------------------------------------------------------------------------------------------
+# lidar
+# ------------------------------------------------------------------------------------------------
+@njit(cache=True, parallel=True)
+def scan_worlds(
+    due: B1, poses: F64, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
+    range_min: float, range_max: float,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    ped_pos: F64, ped_r: F64, ped_n: I64,
+    seg_a: F64, seg_b: F64, seg_n: I64, out: F64,
+) -> None:
+    """Scan every world whose ``due`` flag is set into ``out[i]`` (``(N, B)`` ranges, m).
+
+    Each world is cast by Arena's single-robot kernel (:func:`arena.sensors.lidar2d._scan_kernel`)
+    on its own map, pedestrians (solid circles) and obstacle edges, so a world's scan is
+    bit-identical to :meth:`Lidar2D.scan` of the same scene.
+    """
+    no_owner = np.zeros(0, dtype=np.int64)
+    no_pts = np.zeros((0, 2))
+    for i in prange(poses.shape[0]):
+        if not due[i]:
+            continue
+        distg = _world_map(dist_flat, offs, shapes, i)
+        n = ped_n[i]
+        s = seg_n[i]
+        _scan_kernel(
+            poses[i : i + 1], mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
+            distg, res[i], origin[i, 0], origin[i, 1],
+            ped_pos[i, :n], ped_r[i, :n], no_owner,
+            seg_a[i, :s], seg_b[i, :s], no_owner, no_pts, no_pts, no_owner,
+            False, out[i : i + 1],
+        )
+
+
+# ------------------------------------------------------------------------------------------------
+# contacts
+# ------------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _circle_hits_grid(
+    x: float, y: float, r: float, distg: F32, res: float, gx0: float, gy0: float
+) -> bool:
+    """Circle footprint vs blocking cells or the map border (as native2d's ``hits_grid``)."""
+    h, w = distg.shape
+    xmax = gx0 + w * res
+    ymax = gy0 + h * res
+    if not (gx0 <= x < xmax and gy0 <= y < ymax):
+        return True
+    if x - r < gx0 or y - r < gy0 or x + r > xmax or y + r > ymax:
+        return True
+    col = int((x - gx0) // res)
+    row = int((y - gy0) // res)
+    if distg[row, col] * res - res * SQRT2 >= r:
+        return False
+    k = math.ceil(r / res) + 1
+    half = 0.5 * res
+    for rr in range(max(row - k, 0), min(row + k + 1, h)):
+        for cc in range(max(col - k, 0), min(col + k + 1, w)):
+            if distg[rr, cc] != 0.0:
+                continue
+            ddx = max(abs(gx0 + (cc + 0.5) * res - x) - half, 0.0)
+            ddy = max(abs(gy0 + (rr + 0.5) * res - y) - half, 0.0)
+            if ddx * ddx + ddy * ddy < r * r:
+                return True
+    return False
+
+
+@njit(cache=True)
+def _seg_dist(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> float:
+    ex = bx - ax
+    ey = by - ay
+    ee = ex * ex + ey * ey
+    t = ((px - ax) * ex + (py - ay) * ey) / ee if ee > 0.0 else 0.0
+    t = min(max(t, 0.0), 1.0)
+    return math.hypot(px - ax - t * ex, py - ay - t * ey)
+
+
+@njit(cache=True)
+def _circle_hits_obstacle(
+    x: float, y: float, r: float, seg_a: F64, seg_b: F64, owner: I64, s: int
+) -> int:
+    """Index of an obstacle (closed convex or not polygon) the circle overlaps, or -1."""
+    k = 0
+    while k < s:
+        ob = owner[k]
+        inside = False
+        near = False
+        while k < s and owner[k] == ob:
+            ax, ay = seg_a[k, 0], seg_a[k, 1]
+            bx, by = seg_b[k, 0], seg_b[k, 1]
+            if (ay > y) != (by > y) and x < ax + (y - ay) * (bx - ax) / (by - ay):
+                inside = not inside  # crossing number
+            if _seg_dist(x, y, ax, ay, bx, by) <= r:
+                near = True
+            k += 1
+        if inside or near:
+            return int(ob)
+    return -1
+
+
+@njit(cache=True, parallel=True)
+def contacts_worlds(
+    new_poses: F64, old_poses: F64, sweep: bool, radius: F64,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    seg_a: F64, seg_b: F64, seg_owner: I64, seg_n: I64,
+    ped_pos: F64, ped_r: F64, ped_n: I64,
+    wall: B1, obstacle: I64, agent: I64,
+) -> None:
+    """Contacts of each world's circular robot footprint at ``new_poses``.
+
+    Walls are also tested at poses swept from ``old_poses`` (spacing ``max(res/2, r/2)``, as
+    native2d) so a fast robot cannot tunnel through a thin wall; obstacles and pedestrians at
+    the end pose only. ``agent`` is the nearest overlapping pedestrian.
+    """
+    for i in prange(new_poses.shape[0]):
+        distg = _world_map(dist_flat, offs, shapes, i)
+        r = radius[i]
+        x, y = new_poses[i, 0], new_poses[i, 1]
+        rs = res[i]
+        gx0, gy0 = origin[i, 0], origin[i, 1]
+        hit = False
+        k = 1
+        if sweep:
+            dist = math.hypot(x - old_poses[i, 0], y - old_poses[i, 1])
+            k = max(math.ceil(dist / max(rs * 0.5, r * 0.5)), 1)
+        for j in range(1, k + 1):
+            s = j / k
+            if k == 1:
+                px, py = x, y
+            else:
+                px = old_poses[i, 0] + s * (x - old_poses[i, 0])
+                py = old_poses[i, 1] + s * (y - old_poses[i, 1])
+            if _circle_hits_grid(px, py, r, distg, rs, gx0, gy0):
+                hit = True
+                break
+        wall[i] = hit
+        obstacle[i] = _circle_hits_obstacle(x, y, r, seg_a[i], seg_b[i], seg_owner[i], seg_n[i])
+        best = -1
+        best_d = math.inf
+        for j in range(ped_n[i]):
+            d = math.hypot(ped_pos[i, j, 0] - x, ped_pos[i, j, 1] - y)
+            if d < ped_r[i, j] + r and d < best_d:
+                best = j
+                best_d = d
+        agent[i] = best
+
+
+# ------------------------------------------------------------------------------------------------
+# crowd
+# ------------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _wall_distance(distg: F32, res: float, gx0: float, gy0: float, x: float, y: float) -> float:
+    """Approximate distance (m) from ``(x, y)`` to the nearest blocking cell's surface.
+
+    Cell-centre distance transform at the point's cell less half a cell; 0 in a blocking cell
+    or off the map (off-map counts as a wall for pedestrians).
+    """
+    h, w = distg.shape
+    col = math.floor((x - gx0) / res)
+    row = math.floor((y - gy0) / res)
+    if col < 0 or row < 0 or col >= w or row >= h:
+        return 0.0
+    d = distg[row, col]
+    if d == 0.0:
+        return 0.0
+    return max(float(d) * res - 0.5 * res, 0.0)
+
+
+@njit(cache=True)
+def _wall_gradient(
+    distg: F32, res: float, gx0: float, gy0: float, x: float, y: float
+) -> tuple[float, float]:
+    """Unit direction of increasing wall distance (central differences on the map), or 0."""
+    h, w = distg.shape
+    col = min(max(math.floor((x - gx0) / res), 1), w - 2)
+    row = min(max(math.floor((y - gy0) / res), 1), h - 2)
+    gx = float(distg[row, col + 1]) - float(distg[row, col - 1])
+    gy = float(distg[row + 1, col]) - float(distg[row - 1, col])
+    n = math.hypot(gx, gy)
+    if n == 0.0:
+        return 0.0, 0.0
+    return gx / n, gy / n
+
+
+@njit(cache=True, parallel=True)
+def crowd_worlds(
+    active: B1, pos: F64, vel: F64, heading: F64, radii: F64, vmax: F64, ped_n: I64,
+    wps: F64, n_wp: I64, wp_mode: I64, wp_idx: I64, rand: F64, rand_k: I64,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    seg_a: F64, seg_b: F64, seg_n: I64, robot_xy: F64, robot_r: F64,
+    prm: F64, dt: float, out_pos: F64, out_vel: F64,
+) -> None:
+    """One social-force step of every active world's pedestrians (Helbing-style, no groups).
+
+    Acceleration of pedestrian ``a`` = ``(vmax·e_goal − v)/τ``
+    ``+ Σ_b A_p·exp((r_a + r_b − d)/B_p)·n_ba`` (other pedestrians within ``cutoff``)
+    ``+ A_r·exp((r_a + R − d)/B_r)·n`` (the robot, footprint radius ``R``)
+    ``+ A_w·exp((r_a − d_w)/B_w)·∇d_w`` (walls, from the distance map, within ``cutoff``)
+    ``+ Σ A_w·exp((r_a − d_s)/B_w)·n_s`` (obstacle edges within ``cutoff``).
+    Semi-implicit Euler; speed capped at ``vfac·vmax``. A move that would put the centre in a
+    blocking cell, or bring the body closer into a wall it already touches, is cancelled (the
+    pedestrian stops), so nobody walks into a wall. Within ``goal_radius`` of its waypoint a
+    pedestrian switches to the next one (loop), or to one drawn from ``rand`` (random mode).
+    Reads ``pos``/``vel`` and writes ``out_pos``/``out_vel`` (order-independent).
+    """
+    tau = prm[P_TAU]
+    goal_r = prm[P_GOAL_R]
+    a_p, b_p = prm[P_A_PED], prm[P_B_PED]
+    a_w, b_w = prm[P_A_WALL], prm[P_B_WALL]
+    a_r, b_r = prm[P_A_ROB], prm[P_B_ROB]
+    cutoff = prm[P_CUTOFF]
+    vfac = prm[P_VFAC]
+    for w in prange(pos.shape[0]):
+        n = ped_n[w]
+        if not active[w] or n == 0:
+            for a in range(n):
+                out_pos[w, a, 0] = pos[w, a, 0]
+                out_pos[w, a, 1] = pos[w, a, 1]
+                out_vel[w, a, 0] = vel[w, a, 0]
+                out_vel[w, a, 1] = vel[w, a, 1]
+            continue
+        distg = _world_map(dist_flat, offs, shapes, w)
+        rs = res[w]
+        gx0, gy0 = origin[w, 0], origin[w, 1]
+        s_n = seg_n[w]
+        for a in range(n):
+            x, y = pos[w, a, 0], pos[w, a, 1]
+            vx, vy = vel[w, a, 0], vel[w, a, 1]
+            ra = radii[w, a]
+            # -- goal --
+            k = wp_idx[w, a]
+            gx = wps[w, a, k, 0] - x
+            gy = wps[w, a, k, 1] - y
+            gd = math.hypot(gx, gy)
+            if gd < goal_r:
+                m = n_wp[w, a]
+                if wp_mode[w, a] == 0 or m < 2:
+                    k = (k + 1) % m
+                else:
+                    u = rand[w, rand_k[w] % rand.shape[1]]
+                    rand_k[w] += 1
+                    k2 = min(int(u * (m - 1)), m - 2)
+                    k = k2 + 1 if k2 >= k else k2  # any waypoint but the current one
+                wp_idx[w, a] = k
+                gx = wps[w, a, k, 0] - x
+                gy = wps[w, a, k, 1] - y
+                gd = math.hypot(gx, gy)
+            ax = -vx / tau
+            ay = -vy / tau
+            if gd > 1e-9:
+                ax += vmax[w, a] * gx / gd / tau
+                ay += vmax[w, a] * gy / gd / tau
+            # -- other pedestrians --
+            for b in range(n):
+                if b == a:
+                    continue
+                dx = x - pos[w, b, 0]
+                dy = y - pos[w, b, 1]
+                d = math.hypot(dx, dy)
+                if d >= cutoff:
+                    continue
+                if d < 1e-9:  # coincident: push apart along a fixed, index-ordered axis
+                    dx, dy, d = (1.0 if a > b else -1.0), 0.0, 1.0
+                f = a_p * math.exp((ra + radii[w, b] - d) / b_p)
+                ax += f * dx / d
+                ay += f * dy / d
+            # -- robot --
+            dx = x - robot_xy[w, 0]
+            dy = y - robot_xy[w, 1]
+            d = math.hypot(dx, dy)
+            if 1e-9 < d < cutoff:
+                f = a_r * math.exp((ra + robot_r[w] - d) / b_r)
+                ax += f * dx / d
+                ay += f * dy / d
+            # -- walls --
+            dw = _wall_distance(distg, rs, gx0, gy0, x, y)
+            if dw < cutoff:
+                nx, ny = _wall_gradient(distg, rs, gx0, gy0, x, y)
+                f = a_w * math.exp((ra - dw) / b_w)
+                ax += f * nx
+                ay += f * ny
+            # -- obstacle edges --
+            for s in range(s_n):
+                qx, qy = seg_a[w, s, 0], seg_a[w, s, 1]
+                ex = seg_b[w, s, 0] - qx
+                ey = seg_b[w, s, 1] - qy
+                ee = ex * ex + ey * ey
+                t = ((x - qx) * ex + (y - qy) * ey) / ee if ee > 0.0 else 0.0
+                t = min(max(t, 0.0), 1.0)
+                dx = x - qx - t * ex
+                dy = y - qy - t * ey
+                d = math.hypot(dx, dy)
+                if 1e-9 < d < cutoff:
+                    f = a_w * math.exp((ra - d) / b_w)
+                    ax += f * dx / d
+                    ay += f * dy / d
+            # -- integrate --
+            nvx = vx + ax * dt
+            nvy = vy + ay * dt
+            sp = math.hypot(nvx, nvy)
+            cap = vfac * vmax[w, a]
+            if sp > cap:
+                nvx *= cap / sp
+                nvy *= cap / sp
+            nx_ = x + nvx * dt
+            ny_ = y + nvy * dt
+            dw_new = _wall_distance(distg, rs, gx0, gy0, nx_, ny_)
+            if dw_new == 0.0 or (dw_new < ra and dw_new < dw):
+                nx_, ny_, nvx, nvy = x, y, 0.0, 0.0
+            out_pos[w, a, 0] = nx_
+            out_pos[w, a, 1] = ny_
+            out_vel[w, a, 0] = nvx
+            out_vel[w, a, 1] = nvy
+            if math.hypot(nvx, nvy) > 0.05:
+                heading[w, a] = math.atan2(nvy, nvx)
