@@ -14,6 +14,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.simulator import PedestrianConfig
+from arena.learn.config import LearningConfig
 from arena.nav.stack import NavigationConfig
 from arena.tasks.config import TaskConfig
 
@@ -72,3 +73,6 @@ class ExperimentConfig(_Strict):
     sim: SimConfig = Field(default_factory=SimConfig)
     output: OutputConfig = Field(default_factory=OutputConfig)
     evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)
+    learning: LearningConfig = Field(
+        default_factory=LearningConfig, description="RL environments (arena.learn)"
+    )

@@ -28,6 +28,7 @@ COVERED = {
     "robot": "tests/robots/test_presets.py",
     "map generator": "here",
     "metric": "tests/conformance/test_metrics_conformance.py",
+    "reward term": "tests/learn/test_rewards.py",
 }
 
 

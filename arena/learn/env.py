@@ -1,0 +1,112 @@
+"""``arena/SocialNav-v0``: one robot crossing a crowd, as a Gymnasium environment.
+
+Description:
+    A robot (``cfg.robot``) must reach a goal on the experiment's map among the experiment's
+    pedestrians and obstacles, simulated by the native 2-D backend. Episodes come from the
+    task generator exactly as in ``arena run`` (same seed and index → same episode).
+
+Action Space:
+    ``Discrete(k)`` (the robot's discrete actions or a custom ``n_linear × n_angular`` grid)
+    or a ``Box`` of ``[v, ω]`` (``[vx, vy, ω]`` for holonomic robots) in m/s, rad/s; see
+    :mod:`arena.learn.actions`. Each action is held for ``action_period`` seconds.
+
+Observation Space:
+    A ``Dict`` (or, with ``observation.flatten``, one float32 ``Box``) of ``lidar``, ``goal``,
+    ``last_action``, ``pedestrians`` + ``pedestrians_mask`` and ``semantic``; see
+    :mod:`arena.learn.observations`.
+
+Rewards:
+    The configured reward terms (:mod:`arena.learn.rewards`), Arena's ``default.yaml`` unless
+    ``learning.env.reward`` says otherwise; ``info["reward_terms"]`` has each term's share.
+
+Starting State:
+    The episode's start pose, at rest; people at their spawn positions.
+
+Episode End:
+    Terminated when the robot is within ``task.goal_radius`` of the goal (success; the heading
+    is not checked, as in Arena's training) or touches anything (collision). Truncated after
+    ``max_steps`` env steps or ``task.timeout`` seconds. ``info["outcome"]`` is ``success``,
+    ``collision`` or ``timeout`` at the end, else ``None``.
+
+Arguments:
+    config: an :class:`~arena.config.schema.ExperimentConfig`, a YAML path or ``None`` (the
+        packaged default); ``overrides`` (``key.path=value``) apply to a path.
+    robot: a robot model replacing ``cfg.robot`` (e.g. fewer beams).
+    render_mode: ``None`` or ``"rgb_array"``.
+
+Example::
+
+    import gymnasium as gym
+    import arena.learn  # registers the id
+    env = gym.make("arena/SocialNav-v0", config="my.yaml", overrides=["learning.env.max_steps=300"])
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, ClassVar, SupportsFloat
+
+import gymnasium as gym
+import numpy as np
+
+from arena.learn.driver import ConfigLike, EpisodeDriver, action_period_fps, resolve_config
+from arena.robots.model import RobotModel
+
+
+class SocialNavEnv(gym.Env[Any, Any]):
+    """One robot, one world; see the module docstring for the contract."""
+
+    metadata: ClassVar[dict[str, Any]] = {"render_modes": ["rgb_array"], "render_fps": 10}
+
+    def __init__(
+        self,
+        config: ConfigLike = None,
+        overrides: Sequence[str] = (),
+        *,
+        robot: RobotModel | None = None,
+        render_mode: str | None = None,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be one of {self.metadata['render_modes']}")
+        self.cfg = resolve_config(config, overrides)
+        self.driver = EpisodeDriver(self.cfg, robot, n_robots=1)
+        self.render_mode = render_mode
+        self.metadata = {**self.metadata, "render_fps": action_period_fps(self.driver.period)}
+        self.observation_space = self.driver.obs_builder.space
+        self.action_space = self.driver.decoder.space
+        self._started = False
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Start the next episode; ``seed`` restarts at episode 0 of that seed.
+
+        ``options={"episode": i}`` picks episode ``i`` of the current seed.
+        """
+        super().reset(seed=seed)
+        index = (options or {}).get("episode")
+        obs = self.driver.reset(seed=seed, index=index)
+        self._started = True
+        info = self.driver.info()
+        info["outcome"] = None
+        return self.driver.obs_builder.single(obs), info
+
+    def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
+        """Hold ``action`` for one action period."""
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
+        res = self.driver.step(np.asarray(action)[None, ...])
+        info = self.driver.info()
+        info["outcome"] = res.outcomes[0]
+        info["reward_terms"] = {k: float(v[0]) for k, v in res.reward.terms.items()}
+        info["collision"] = bool(res.collision[0])
+        obs = self.driver.obs_builder.single(res.obs)
+        return (
+            obs, float(res.reward.total[0]), bool(res.terminated[0]), bool(res.truncated[0]), info
+        )
+
+    def render(self) -> Any:
+        """An RGB frame ``(H, W, 3)`` uint8 in ``rgb_array`` mode, else ``None``."""
+        if self.render_mode != "rgb_array" or not self._started:
+            return None
+        return self.driver.render()

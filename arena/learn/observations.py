@@ -1,0 +1,255 @@
+"""Observations for ``N`` worlds at once, and their gymnasium spaces (arena_specs §8.2).
+
+Dict keys (each present only when enabled; arrays below are per world, the builder returns
+them with a leading ``N`` axis):
+
+================== =================== =======================================================
+``lidar``          ``(stack, beams)``  ranges (m) in ``[0, range_max]``, oldest scan first
+``goal``           ``(2,)``            ``[ρ m, θ rad]``, robot frame, θ = 0 straight ahead,
+                                       ρ clipped to ``goal_max_distance``
+                                       (Arena offsets θ by π, §10.9; we do not)
+``last_action``    ``(3,)``            last command ``[vx m/s, vy m/s, ω rad/s]``
+``pedestrians``    ``(k, 6)``          k nearest people within ``max_range``, nearest first:
+                                       ``[x m, y m, vx m/s, vy m/s, type, social_state]`` with
+                                       position and velocity relative to the robot, in its
+                                       frame; type 0 adult, 1 elder, −1 other (Arena's codes);
+                                       social_state the :class:`~arena.crowd.state.SocialState`
+                                       code; empty slots are zero
+``pedestrians_mask`` ``(k,)``          1 where a slot holds a person, else 0
+``semantic``       ``(C, size, size)`` ego-centric feature maps, ROI ``roi`` m centred on the
+                                       robot, row ↔ robot-frame y, column ↔ x; cell
+                                       ``floor(x / roi · size) + size / 2`` (Arena truncates
+                                       with ``int``, which doubles the centre cells)
+================== =================== =======================================================
+
+Semantic channels: ``pedestrian_location`` 1, ``pedestrian_type`` the type code,
+``pedestrian_vel_x``/``_vel_y`` the person's velocity in the robot frame (m/s; Arena writes the
+world-frame force), ``pedestrian_social_state`` Arena's animation code (``evidence >> 8``,
+1 idle … 6 phone). With ``flatten`` the parts are concatenated in the order above into one
+float32 vector.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from gymnasium import spaces
+from numpy.typing import NDArray
+
+from arena.crowd.semantic import decode_animation, encode_social_state, pedestrian_type_codes
+from arena.learn.config import ObservationConfig
+from arena.robots.model import RobotModel
+
+FloatArray = NDArray[np.float64]
+Obs = dict[str, NDArray[np.float32]]
+
+PED_FEATURES = ("x", "y", "vx", "vy", "type", "social_state")
+"""Columns of the ``pedestrians`` observation."""
+MAX_SPEED = 20.0
+"""m/s; velocity features are clipped to ±this (keeps the space bounded)."""
+_N_STATES = 7
+
+
+@dataclass(frozen=True, eq=False)
+class ObsInput:
+    """World state for ``N`` worlds (``M`` pedestrian slots each).
+
+    Attributes:
+        poses: ``(N, 3)`` robot poses ``[x m, y m, ψ rad]``.
+        twists: ``(N, 3)`` body-frame velocities ``[vx, vy, ω]``.
+        goals: ``(N, 2)`` goal positions (m).
+        scans: ``(N, stack, beams)`` most recent laser scans (m), oldest first.
+        last_action: ``(N, 3)`` last command.
+        ped_pos: ``(N, M, 2)`` m.
+        ped_vel: ``(N, M, 2)`` m/s, world frame.
+        ped_kind: ``(N, M)`` type codes (0 adult, 1 elder, 2 child).
+        ped_state: ``(N, M)`` social-state codes.
+        ped_mask: ``(N, M)`` bool, the slot holds a person.
+    """
+
+    poses: FloatArray
+    twists: FloatArray
+    goals: FloatArray
+    scans: FloatArray
+    last_action: FloatArray
+    ped_pos: FloatArray
+    ped_vel: FloatArray
+    ped_kind: NDArray[np.int64]
+    ped_state: NDArray[np.int64]
+    ped_mask: NDArray[np.bool_]
+
+
+def goal_polar(poses: FloatArray, goals: FloatArray) -> FloatArray:
+    """``(N, 2)`` ``[ρ, θ]``: distance (m) and bearing (rad, ``[−π, π)``, 0 straight ahead)."""
+    d = goals[:, :2] - poses[:, :2]
+    rho = np.hypot(d[:, 0], d[:, 1])
+    theta = (np.arctan2(d[:, 1], d[:, 0]) - poses[:, 2] + np.pi) % (2 * np.pi) - np.pi
+    return np.column_stack([rho, theta])
+
+
+def to_robot_frame(vectors: FloatArray, headings: FloatArray) -> FloatArray:
+    """Rotate ``(N, M, 2)`` world-frame vectors by ``−ψ`` of each world's robot ``(N,)``."""
+    c, s = np.cos(headings)[:, None], np.sin(headings)[:, None]
+    x, y = vectors[..., 0], vectors[..., 1]
+    return np.stack([c * x + s * y, -s * x + c * y], axis=-1)
+
+
+class ObservationBuilder:
+    """Observation space and batched construction for one robot model.
+
+    Args:
+        config: the ``learning.env.observation`` block.
+        robot: the robot model (laser beams and range, velocity limits).
+    """
+
+    def __init__(self, config: ObservationConfig, robot: RobotModel) -> None:
+        self.config = config
+        self.beams = int(robot.laser.num_beams)
+        self.range_max = float(robot.laser.range_max)
+        lim = robot.limits()
+        parts: dict[str, spaces.Box] = {}
+        if config.lidar:
+            parts["lidar"] = spaces.Box(
+                0.0, self.range_max, (config.laser_stack, self.beams), np.float32
+            )
+        if config.goal:
+            parts["goal"] = spaces.Box(
+                np.array([0.0, -np.pi], np.float32),
+                np.array([config.goal_max_distance, np.pi], np.float32),
+            )
+        if config.last_action:
+            # vy is 0 for non-holonomic robots; its bounds then reuse vx's (no empty interval)
+            vy = (lim.vy_min, lim.vy_max) if lim.vy_max > lim.vy_min else (lim.vx_min, lim.vx_max)
+            lo = np.array([lim.vx_min, vy[0], -lim.omega_max], np.float32)
+            hi = np.array([lim.vx_max, vy[1], lim.omega_max], np.float32)
+            parts["last_action"] = spaces.Box(np.minimum(lo, 0), np.maximum(hi, 0))
+        pc = config.pedestrians
+        if pc.enabled:
+            r, v = pc.max_range, MAX_SPEED
+            lo = np.array([-r, -r, -v, -v, -1, 0], np.float32)
+            hi = np.array([r, r, v, v, 1, _N_STATES - 1], np.float32)
+            parts["pedestrians"] = spaces.Box(
+                np.tile(lo, (pc.k, 1)), np.tile(hi, (pc.k, 1)), dtype=np.float32
+            )
+            parts["pedestrians_mask"] = spaces.Box(0.0, 1.0, (pc.k,), np.float32)
+        sc = config.semantic
+        if sc.enabled:
+            bounds = {
+                "pedestrian_location": (0.0, 1.0),
+                "pedestrian_type": (-1.0, 1.0),
+                "pedestrian_vel_x": (-MAX_SPEED, MAX_SPEED),
+                "pedestrian_vel_y": (-MAX_SPEED, MAX_SPEED),
+                "pedestrian_social_state": (0.0, 6.0),
+            }
+            lo = np.array([min(bounds[c][0], 0.0) for c in sc.channels], np.float32)
+            hi = np.array([bounds[c][1] for c in sc.channels], np.float32)
+            shape = (len(sc.channels), sc.size, sc.size)
+            parts["semantic"] = spaces.Box(
+                np.broadcast_to(lo[:, None, None], shape).copy(),
+                np.broadcast_to(hi[:, None, None], shape).copy(),
+                dtype=np.float32,
+            )
+        if not parts:
+            raise ValueError("the observation is empty: enable at least one part")
+        self.dict_space = spaces.Dict(parts)
+        self.keys = tuple(self.dict_space.keys())  # the order flatten_space uses
+        self.space: spaces.Space[object] = (
+            spaces.flatten_space(self.dict_space) if config.flatten else self.dict_space
+        )
+
+    def build(self, inp: ObsInput) -> Obs:
+        """The observation dict with a leading ``N`` axis."""
+        n = inp.poses.shape[0]
+        out: Obs = {}
+        cfg = self.config
+        if "lidar" in self.keys:
+            out["lidar"] = np.clip(inp.scans, 0.0, self.range_max).astype(np.float32)
+        if "goal" in self.keys:
+            g = goal_polar(inp.poses, inp.goals)
+            g[:, 0] = np.minimum(g[:, 0], cfg.goal_max_distance)
+            out["goal"] = g.astype(np.float32)
+        if "last_action" in self.keys:
+            sp = self.dict_space["last_action"]
+            out["last_action"] = np.clip(inp.last_action, sp.low, sp.high).astype(np.float32)
+        rel = to_robot_frame(inp.ped_pos - inp.poses[:, None, :2], inp.poses[:, 2])
+        if cfg.pedestrians.enabled:
+            out.update(self._pedestrians(inp, rel, n))
+        if cfg.semantic.enabled:
+            out["semantic"] = self._semantic(inp, rel, n)
+        return out
+
+    def _robot_world_velocity(self, inp: ObsInput) -> FloatArray:
+        c, s = np.cos(inp.poses[:, 2]), np.sin(inp.poses[:, 2])
+        vx, vy = inp.twists[:, 0], inp.twists[:, 1]
+        return np.column_stack([c * vx - s * vy, s * vx + c * vy])
+
+    def _pedestrians(self, inp: ObsInput, rel: FloatArray, n: int) -> Obs:
+        pc = self.config.pedestrians
+        k = pc.k
+        feats = np.zeros((n, k, len(PED_FEATURES)), np.float32)
+        mask = np.zeros((n, k), np.float32)
+        m = rel.shape[1]
+        if m:
+            dist = np.hypot(rel[..., 0], rel[..., 1])
+            valid = inp.ped_mask & (dist <= pc.max_range)
+            key = np.where(valid, dist, np.inf)
+            order = np.argsort(key, axis=1, kind="stable")[:, :k]
+            take = order.shape[1]
+            rows = np.arange(n)[:, None]
+            ok = valid[rows, order]
+            rel_v = to_robot_frame(
+                inp.ped_vel - self._robot_world_velocity(inp)[:, None, :], inp.poses[:, 2]
+            )
+            f = np.concatenate(
+                [
+                    rel[rows, order],
+                    np.clip(rel_v[rows, order], -MAX_SPEED, MAX_SPEED),
+                    pedestrian_type_codes(inp.ped_kind[rows, order])[..., None],
+                    np.clip(inp.ped_state[rows, order], 0, _N_STATES - 1)[..., None],
+                ],
+                axis=-1,
+            )
+            feats[:, :take] = np.where(ok[..., None], f, 0.0)
+            mask[:, :take] = ok
+        return {"pedestrians": feats, "pedestrians_mask": mask}
+
+    def _semantic(self, inp: ObsInput, rel: FloatArray, n: int) -> NDArray[np.float32]:
+        sc = self.config.semantic
+        size = sc.size
+        grid = np.zeros((n, len(sc.channels), size, size), np.float32)
+        if rel.shape[1] == 0:
+            return grid
+        col = np.floor(rel[..., 0] / sc.roi * size).astype(np.int64) + size // 2
+        row = np.floor(rel[..., 1] / sc.roi * size).astype(np.int64) + size // 2
+        inside = inp.ped_mask & (col >= 0) & (col < size) & (row >= 0) & (row < size)
+        w, p = np.nonzero(inside)
+        if w.size == 0:
+            return grid
+        vel = to_robot_frame(inp.ped_vel, inp.poses[:, 2])[w, p]
+        values = {
+            "pedestrian_location": np.ones(w.size),
+            "pedestrian_type": pedestrian_type_codes(inp.ped_kind[w, p]),
+            "pedestrian_vel_x": np.clip(vel[:, 0], -MAX_SPEED, MAX_SPEED),
+            "pedestrian_vel_y": np.clip(vel[:, 1], -MAX_SPEED, MAX_SPEED),
+            "pedestrian_social_state": decode_animation(encode_social_state(inp.ped_state[w, p])),
+        }
+        vals = np.column_stack([values[c] for c in sc.channels]).astype(np.float32)
+        chan = np.arange(len(sc.channels))
+        grid[w[:, None], chan[None, :], row[w, p][:, None], col[w, p][:, None]] = vals
+        return grid
+
+    def flatten(self, obs: Obs) -> NDArray[np.float32]:
+        """``(N, D)`` float32: the parts of a batched observation concatenated in key order."""
+        n = next(iter(obs.values())).shape[0]
+        return np.concatenate([obs[k].reshape(n, -1) for k in self.keys], axis=1).astype(
+            np.float32
+        )
+
+    def single(
+        self, obs: Obs, i: int = 0
+    ) -> dict[str, NDArray[np.float32]] | NDArray[np.float32]:
+        """World ``i`` of a batched observation, in the form of :attr:`space`."""
+        if self.config.flatten:
+            return self.flatten({k: v[i : i + 1] for k, v in obs.items()})[0]
+        return {k: obs[k][i] for k in self.keys}
