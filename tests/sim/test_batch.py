@@ -181,3 +181,24 @@ def test_reset_world_with_another_map_keeps_shared_map(episodes: list[Episode]) 
     np.testing.assert_array_equal(after.scans[1], fresh.scans[0])
     back = sim.reset_world(1, episodes[1], np.random.default_rng(2))
     np.testing.assert_array_equal(back.scans, before.scans)
+
+
+@pytest.mark.parametrize("parallel_min_worlds", [1, 100])  # thread pool and serial path
+def test_scans_bit_identical_to_lidar2d(episodes: list[Episode], parallel_min_worlds: int) -> None:
+    from arena.sensors.lidar2d import Lidar2D
+
+    sim = BatchSim(8, BatchSim.Params(parallel_min_worlds=parallel_min_worlds))
+    s = sim.reset(episodes, np.random.default_rng(2))
+    for c in _commands(12, 8):
+        s = sim.step(c, 0.1)
+    lidar = Lidar2D(sim.lidar_spec)
+    for i, ep in enumerate(episodes):
+        a = np.concatenate([ob.polygon for ob in ep.obstacles]) if ep.obstacles else None
+        b = (
+            np.concatenate([np.roll(ob.polygon, -1, axis=0) for ob in ep.obstacles])
+            if ep.obstacles else None
+        )
+        lidar.bind(ep.grid, a, b)
+        m = s.ped_mask[i]
+        ref = lidar.scan(s.poses[i], s.ped_positions[i][m], s.ped_radii[i][m])
+        np.testing.assert_array_equal(s.scans[i], ref)

@@ -20,7 +20,15 @@ import numpy as np
 from numba import njit, prange
 from numpy.typing import NDArray
 
-from arena.sensors.lidar2d import _scan_kernel
+from arena.sensors.lidar2d import (
+    _AXIS_SNAP,
+    _beam_window,
+    _cast_grid_many,
+    _circle_hit,
+    _fast_atan2,
+    _origin_touches_wall,
+    _segments_into,
+)
 
 F64 = NDArray[np.float64]
 F32 = NDArray[np.float32]
@@ -28,6 +36,7 @@ I64 = NDArray[np.int64]
 B1 = NDArray[np.bool_]
 
 SQRT2 = math.sqrt(2.0)
+_NO_OWNER = np.zeros(0, dtype=np.int64)
 
 #: Collision kinds reported per world (the first that applies, in this order).
 KIND_NONE = 0
@@ -52,6 +61,77 @@ def _world_map(dist_flat: F32, offs: I64, shapes: I64, i: int) -> F32:
 # ------------------------------------------------------------------------------------------------
 # lidar
 # ------------------------------------------------------------------------------------------------
+@njit(cache=True)
+def _scan_one(
+    pose: F64, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
+    range_min: float, range_max: float, distg: F32, res: float, gx0: float, gy0: float,
+    circ_xy: F64, circ_r: F64, seg_a: F64, seg_b: F64,
+    dx: F64, dy: F64, tlim: F64, tg: F64, t1s: F64, active: I64, pending: I64, best: F64,
+) -> None:
+    """One robot's scan into ``best``, with caller-provided scratch arrays.
+
+    :func:`arena.sensors.lidar2d._scan_kernel` for a single pose, no owners and no dynamic
+    segments.
+    The arithmetic is the same, operation by operation, so the ranges are bit-identical.
+    """
+    n = cos_a.shape[0]
+    inv_res = 1.0 / res
+    c = math.cos(pose[2])
+    s = math.sin(pose[2])
+    ox = pose[0] + c * mount[0] - s * mount[1]
+    oy = pose[1] + s * mount[0] + c * mount[1]
+    yaw = pose[2] + mount[2]
+    if not (math.isfinite(ox) and math.isfinite(oy) and math.isfinite(yaw)):
+        raise ValueError("Lidar2D: robot poses must be finite")
+    cy_ = math.cos(yaw)
+    sy_ = math.sin(yaw)
+    for i in range(n):
+        ddx = cy_ * cos_a[i] - sy_ * sin_a[i]
+        ddy = sy_ * cos_a[i] + cy_ * sin_a[i]
+        if abs(ddx) < _AXIS_SNAP:
+            ddx, ddy = 0.0, (1.0 if ddy > 0.0 else -1.0)
+        elif abs(ddy) < _AXIS_SNAP:
+            ddx, ddy = (1.0 if ddx > 0.0 else -1.0), 0.0
+        dx[i] = ddx
+        dy[i] = ddy
+        best[i] = range_max
+    a0 = yaw + angle_min
+    gox = (ox - gx0) * inv_res
+    goy = (oy - gy0) * inv_res
+    if _origin_touches_wall(gox, goy, distg):
+        best[:] = range_min
+        return
+    for k in range(circ_xy.shape[0]):
+        ccx = circ_xy[k, 0] - ox
+        ccy = circ_xy[k, 1] - oy
+        rad = circ_r[k]
+        d2 = ccx * ccx + ccy * ccy
+        c2 = d2 - rad * rad
+        if c2 <= 0.0:
+            best[:] = range_min
+            return
+        dist = math.sqrt(d2)
+        if dist - rad > range_max:
+            continue
+        half = math.asin(min(rad / dist, 1.0))
+        i0, i1, j0, j1 = _beam_window(_fast_atan2(ccy, ccx) - half, 2.0 * half, a0, inc, n)
+        for i in range(i0, i1 + 1):
+            _circle_hit(best, i, dx, dy, ccx, ccy, c2)
+        for i in range(j0, j1 + 1):
+            _circle_hit(best, i, dx, dy, ccx, ccy, c2)
+    _segments_into(best, dx, dy, ox, oy, a0, inc, range_max, seg_a, seg_b, _NO_OWNER, -1)
+    for i in range(n):
+        tlim[i] = best[i] * inv_res
+    _cast_grid_many(gox, goy, dx, dy, tlim, distg, tg, t1s, active, pending)
+    for i in range(n):
+        if tg[i] * res < best[i]:
+            best[i] = tg[i] * res
+        if best[i] < range_min:
+            best[i] = range_min
+        elif best[i] > range_max:
+            best[i] = range_max
+
+
 @njit(cache=True, parallel=True)
 def scan_worlds(
     due: B1, poses: F64, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
@@ -59,28 +139,65 @@ def scan_worlds(
     dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
     ped_pos: F64, ped_r: F64, ped_n: I64,
     seg_a: F64, seg_b: F64, seg_n: I64, out: F64,
+    scratch_f: F64, scratch_i: I64,
 ) -> None:
     """Scan every world whose ``due`` flag is set into ``out[i]`` (``(N, B)`` ranges, m).
 
-    Each world is cast by Arena's single-robot kernel (:func:`arena.sensors.lidar2d._scan_kernel`)
-    on its own map, pedestrians (solid circles) and obstacle edges, so a world's scan is
-    bit-identical to :meth:`Lidar2D.scan` of the same scene.
+    Each world is cast as Arena's single-robot kernel
+    (:func:`arena.sensors.lidar2d._scan_kernel`) casts it, on its own map, pedestrians (solid
+    circles) and obstacle edges, so a world's scan is bit-identical to :meth:`Lidar2D.scan` of
+    the same scene. ``scratch_f`` ``(N, 5, B)`` and ``scratch_i`` ``(N, 2, B)`` are per-world
+    work arrays (nothing is allocated per call).
     """
-    no_owner = np.zeros(0, dtype=np.int64)
-    no_pts = np.zeros((0, 2))
     for i in prange(poses.shape[0]):
         if not due[i]:
             continue
-        distg = _world_map(dist_flat, offs, shapes, i)
-        n = ped_n[i]
-        s = seg_n[i]
-        _scan_kernel(
-            poses[i : i + 1], mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
-            distg, res[i], origin[i, 0], origin[i, 1],
-            ped_pos[i, :n], ped_r[i, :n], no_owner,
-            seg_a[i, :s], seg_b[i, :s], no_owner, no_pts, no_pts, no_owner,
-            False, out[i : i + 1],
+        _scan_world(
+            i, poses, mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
+            dist_flat, offs, shapes, res, origin, ped_pos, ped_r, ped_n,
+            seg_a, seg_b, seg_n, out, scratch_f, scratch_i,
         )
+
+
+@njit(cache=True)
+def scan_worlds_serial(
+    due: B1, poses: F64, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
+    range_min: float, range_max: float,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    ped_pos: F64, ped_r: F64, ped_n: I64,
+    seg_a: F64, seg_b: F64, seg_n: I64, out: F64,
+    scratch_f: F64, scratch_i: I64,
+) -> None:
+    """:func:`scan_worlds` on the calling thread (no thread-pool launch: small ``N``)."""
+    for i in range(poses.shape[0]):
+        if not due[i]:
+            continue
+        _scan_world(
+            i, poses, mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
+            dist_flat, offs, shapes, res, origin, ped_pos, ped_r, ped_n,
+            seg_a, seg_b, seg_n, out, scratch_f, scratch_i,
+        )
+
+
+@njit(cache=True)
+def _scan_world(
+    i: int, poses: F64, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
+    range_min: float, range_max: float,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    ped_pos: F64, ped_r: F64, ped_n: I64,
+    seg_a: F64, seg_b: F64, seg_n: I64, out: F64,
+    scratch_f: F64, scratch_i: I64,
+) -> None:
+    distg = _world_map(dist_flat, offs, shapes, i)
+    n = ped_n[i]
+    s = seg_n[i]
+    sf = scratch_f[i]
+    si = scratch_i[i]
+    _scan_one(
+        poses[i], mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
+        distg, res[i], origin[i, 0], origin[i, 1], ped_pos[i, :n], ped_r[i, :n],
+        seg_a[i, :s], seg_b[i, :s], sf[0], sf[1], sf[2], sf[3], sf[4], si[0], si[1], out[i],
+    )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -148,6 +265,47 @@ def _circle_hits_obstacle(
     return -1
 
 
+@njit(cache=True)
+def _contacts_worlds_one(
+    i: int,
+    new_poses: F64, old_poses: F64, sweep: bool, radius: F64,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    seg_a: F64, seg_b: F64, seg_owner: I64, seg_n: I64,
+    ped_pos: F64, ped_r: F64, ped_n: I64,
+    wall: B1, obstacle: I64, agent: I64,
+) -> None:
+    distg = _world_map(dist_flat, offs, shapes, i)
+    r = radius[i]
+    x, y = new_poses[i, 0], new_poses[i, 1]
+    rs = res[i]
+    gx0, gy0 = origin[i, 0], origin[i, 1]
+    hit = False
+    k = 1
+    if sweep:
+        dist = math.hypot(x - old_poses[i, 0], y - old_poses[i, 1])
+        k = max(math.ceil(dist / max(rs * 0.5, r * 0.5)), 1)
+    for j in range(1, k + 1):
+        s = j / k
+        if k == 1:
+            px, py = x, y
+        else:
+            px = old_poses[i, 0] + s * (x - old_poses[i, 0])
+            py = old_poses[i, 1] + s * (y - old_poses[i, 1])
+        if _circle_hits_grid(px, py, r, distg, rs, gx0, gy0):
+            hit = True
+            break
+    wall[i] = hit
+    obstacle[i] = _circle_hits_obstacle(x, y, r, seg_a[i], seg_b[i], seg_owner[i], seg_n[i])
+    best = -1
+    best_d = math.inf
+    for j in range(ped_n[i]):
+        d = math.hypot(ped_pos[i, j, 0] - x, ped_pos[i, j, 1] - y)
+        if d < ped_r[i, j] + r and d < best_d:
+            best = j
+            best_d = d
+    agent[i] = best
+
+
 @njit(cache=True, parallel=True)
 def contacts_worlds(
     new_poses: F64, old_poses: F64, sweep: bool, radius: F64,
@@ -163,36 +321,26 @@ def contacts_worlds(
     the end pose only. ``agent`` is the nearest overlapping pedestrian.
     """
     for i in prange(new_poses.shape[0]):
-        distg = _world_map(dist_flat, offs, shapes, i)
-        r = radius[i]
-        x, y = new_poses[i, 0], new_poses[i, 1]
-        rs = res[i]
-        gx0, gy0 = origin[i, 0], origin[i, 1]
-        hit = False
-        k = 1
-        if sweep:
-            dist = math.hypot(x - old_poses[i, 0], y - old_poses[i, 1])
-            k = max(math.ceil(dist / max(rs * 0.5, r * 0.5)), 1)
-        for j in range(1, k + 1):
-            s = j / k
-            if k == 1:
-                px, py = x, y
-            else:
-                px = old_poses[i, 0] + s * (x - old_poses[i, 0])
-                py = old_poses[i, 1] + s * (y - old_poses[i, 1])
-            if _circle_hits_grid(px, py, r, distg, rs, gx0, gy0):
-                hit = True
-                break
-        wall[i] = hit
-        obstacle[i] = _circle_hits_obstacle(x, y, r, seg_a[i], seg_b[i], seg_owner[i], seg_n[i])
-        best = -1
-        best_d = math.inf
-        for j in range(ped_n[i]):
-            d = math.hypot(ped_pos[i, j, 0] - x, ped_pos[i, j, 1] - y)
-            if d < ped_r[i, j] + r and d < best_d:
-                best = j
-                best_d = d
-        agent[i] = best
+        _contacts_worlds_one(
+            i, new_poses, old_poses, sweep, radius, dist_flat, offs, shapes, res, origin, seg_a,
+            seg_b, seg_owner, seg_n, ped_pos, ped_r, ped_n, wall, obstacle, agent,
+        )
+
+
+@njit(cache=True)
+def contacts_worlds_serial(
+    new_poses: F64, old_poses: F64, sweep: bool, radius: F64,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    seg_a: F64, seg_b: F64, seg_owner: I64, seg_n: I64,
+    ped_pos: F64, ped_r: F64, ped_n: I64,
+    wall: B1, obstacle: I64, agent: I64,
+) -> None:
+    """:func:`contacts_worlds` on the calling thread (no thread-pool launch: small ``N``)."""
+    for i in range(new_poses.shape[0]):
+        _contacts_worlds_one(
+            i, new_poses, old_poses, sweep, radius, dist_flat, offs, shapes, res, origin, seg_a,
+            seg_b, seg_owner, seg_n, ped_pos, ped_r, ped_n, wall, obstacle, agent,
+        )
 
 
 # ------------------------------------------------------------------------------------------------
@@ -232,6 +380,126 @@ def _wall_gradient(
     return gx / n, gy / n
 
 
+@njit(cache=True)
+def _crowd_worlds_one(
+    w: int,
+    active: B1, pos: F64, vel: F64, heading: F64, radii: F64, vmax: F64, ped_n: I64,
+    wps: F64, n_wp: I64, wp_mode: I64, wp_idx: I64, rand: F64, rand_k: I64,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    seg_a: F64, seg_b: F64, seg_n: I64, robot_xy: F64, robot_r: F64,
+    prm: F64, dt: float, out_pos: F64, out_vel: F64,
+) -> None:
+    tau = prm[P_TAU]
+    goal_r = prm[P_GOAL_R]
+    a_p, b_p = prm[P_A_PED], prm[P_B_PED]
+    a_w, b_w = prm[P_A_WALL], prm[P_B_WALL]
+    a_r, b_r = prm[P_A_ROB], prm[P_B_ROB]
+    cutoff = prm[P_CUTOFF]
+    vfac = prm[P_VFAC]
+    n = ped_n[w]
+    if not active[w] or n == 0:
+        for a in range(n):
+            out_pos[w, a, 0] = pos[w, a, 0]
+            out_pos[w, a, 1] = pos[w, a, 1]
+            out_vel[w, a, 0] = vel[w, a, 0]
+            out_vel[w, a, 1] = vel[w, a, 1]
+        return
+    distg = _world_map(dist_flat, offs, shapes, w)
+    rs = res[w]
+    gx0, gy0 = origin[w, 0], origin[w, 1]
+    s_n = seg_n[w]
+    for a in range(n):
+        x, y = pos[w, a, 0], pos[w, a, 1]
+        vx, vy = vel[w, a, 0], vel[w, a, 1]
+        ra = radii[w, a]
+        # -- goal --
+        k = wp_idx[w, a]
+        gx = wps[w, a, k, 0] - x
+        gy = wps[w, a, k, 1] - y
+        gd = math.hypot(gx, gy)
+        if gd < goal_r:
+            m = n_wp[w, a]
+            if wp_mode[w, a] == 0 or m < 2:
+                k = (k + 1) % m
+            else:
+                u = rand[w, rand_k[w] % rand.shape[1]]
+                rand_k[w] += 1
+                k2 = min(int(u * (m - 1)), m - 2)
+                k = k2 + 1 if k2 >= k else k2  # any waypoint but the current one
+            wp_idx[w, a] = k
+            gx = wps[w, a, k, 0] - x
+            gy = wps[w, a, k, 1] - y
+            gd = math.hypot(gx, gy)
+        ax = -vx / tau
+        ay = -vy / tau
+        if gd > 1e-9:
+            ax += vmax[w, a] * gx / gd / tau
+            ay += vmax[w, a] * gy / gd / tau
+        # -- other pedestrians --
+        for b in range(n):
+            if b == a:
+                continue
+            dx = x - pos[w, b, 0]
+            dy = y - pos[w, b, 1]
+            d = math.hypot(dx, dy)
+            if d >= cutoff:
+                continue
+            if d < 1e-9:  # coincident: push apart along a fixed, index-ordered axis
+                dx, dy, d = (1.0 if a > b else -1.0), 0.0, 1.0
+            f = a_p * math.exp((ra + radii[w, b] - d) / b_p)
+            ax += f * dx / d
+            ay += f * dy / d
+        # -- robot --
+        dx = x - robot_xy[w, 0]
+        dy = y - robot_xy[w, 1]
+        d = math.hypot(dx, dy)
+        if 1e-9 < d < cutoff:
+            f = a_r * math.exp((ra + robot_r[w] - d) / b_r)
+            ax += f * dx / d
+            ay += f * dy / d
+        # -- walls --
+        dw = _wall_distance(distg, rs, gx0, gy0, x, y)
+        if dw < cutoff:
+            nx, ny = _wall_gradient(distg, rs, gx0, gy0, x, y)
+            f = a_w * math.exp((ra - dw) / b_w)
+            ax += f * nx
+            ay += f * ny
+        # -- obstacle edges --
+        for s in range(s_n):
+            qx, qy = seg_a[w, s, 0], seg_a[w, s, 1]
+            ex = seg_b[w, s, 0] - qx
+            ey = seg_b[w, s, 1] - qy
+            ee = ex * ex + ey * ey
+            t = ((x - qx) * ex + (y - qy) * ey) / ee if ee > 0.0 else 0.0
+            t = min(max(t, 0.0), 1.0)
+            dx = x - qx - t * ex
+            dy = y - qy - t * ey
+            d = math.hypot(dx, dy)
+            if 1e-9 < d < cutoff:
+                f = a_w * math.exp((ra - d) / b_w)
+                ax += f * dx / d
+                ay += f * dy / d
+        # -- integrate --
+        nvx = vx + ax * dt
+        nvy = vy + ay * dt
+        sp = math.hypot(nvx, nvy)
+        cap = vfac * vmax[w, a]
+        if sp > cap:
+            nvx *= cap / sp
+            nvy *= cap / sp
+        nx_ = x + nvx * dt
+        ny_ = y + nvy * dt
+        dw_new = _wall_distance(distg, rs, gx0, gy0, nx_, ny_)
+        if dw_new == 0.0 or (dw_new < ra and dw_new < dw):
+            nx_, ny_, nvx, nvy = x, y, 0.0, 0.0
+        out_pos[w, a, 0] = nx_
+        out_pos[w, a, 1] = ny_
+        out_vel[w, a, 0] = nvx
+        out_vel[w, a, 1] = nvy
+        if math.hypot(nvx, nvy) > 0.05:
+            heading[w, a] = math.atan2(nvy, nvx)
+
+
 @njit(cache=True, parallel=True)
 def crowd_worlds(
     active: B1, pos: F64, vel: F64, heading: F64, radii: F64, vmax: F64, ped_n: I64,
@@ -253,113 +521,26 @@ def crowd_worlds(
     pedestrian switches to the next one (loop), or to one drawn from ``rand`` (random mode).
     Reads ``pos``/``vel`` and writes ``out_pos``/``out_vel`` (order-independent).
     """
-    tau = prm[P_TAU]
-    goal_r = prm[P_GOAL_R]
-    a_p, b_p = prm[P_A_PED], prm[P_B_PED]
-    a_w, b_w = prm[P_A_WALL], prm[P_B_WALL]
-    a_r, b_r = prm[P_A_ROB], prm[P_B_ROB]
-    cutoff = prm[P_CUTOFF]
-    vfac = prm[P_VFAC]
     for w in prange(pos.shape[0]):
-        n = ped_n[w]
-        if not active[w] or n == 0:
-            for a in range(n):
-                out_pos[w, a, 0] = pos[w, a, 0]
-                out_pos[w, a, 1] = pos[w, a, 1]
-                out_vel[w, a, 0] = vel[w, a, 0]
-                out_vel[w, a, 1] = vel[w, a, 1]
-            continue
-        distg = _world_map(dist_flat, offs, shapes, w)
-        rs = res[w]
-        gx0, gy0 = origin[w, 0], origin[w, 1]
-        s_n = seg_n[w]
-        for a in range(n):
-            x, y = pos[w, a, 0], pos[w, a, 1]
-            vx, vy = vel[w, a, 0], vel[w, a, 1]
-            ra = radii[w, a]
-            # -- goal --
-            k = wp_idx[w, a]
-            gx = wps[w, a, k, 0] - x
-            gy = wps[w, a, k, 1] - y
-            gd = math.hypot(gx, gy)
-            if gd < goal_r:
-                m = n_wp[w, a]
-                if wp_mode[w, a] == 0 or m < 2:
-                    k = (k + 1) % m
-                else:
-                    u = rand[w, rand_k[w] % rand.shape[1]]
-                    rand_k[w] += 1
-                    k2 = min(int(u * (m - 1)), m - 2)
-                    k = k2 + 1 if k2 >= k else k2  # any waypoint but the current one
-                wp_idx[w, a] = k
-                gx = wps[w, a, k, 0] - x
-                gy = wps[w, a, k, 1] - y
-                gd = math.hypot(gx, gy)
-            ax = -vx / tau
-            ay = -vy / tau
-            if gd > 1e-9:
-                ax += vmax[w, a] * gx / gd / tau
-                ay += vmax[w, a] * gy / gd / tau
-            # -- other pedestrians --
-            for b in range(n):
-                if b == a:
-                    continue
-                dx = x - pos[w, b, 0]
-                dy = y - pos[w, b, 1]
-                d = math.hypot(dx, dy)
-                if d >= cutoff:
-                    continue
-                if d < 1e-9:  # coincident: push apart along a fixed, index-ordered axis
-                    dx, dy, d = (1.0 if a > b else -1.0), 0.0, 1.0
-                f = a_p * math.exp((ra + radii[w, b] - d) / b_p)
-                ax += f * dx / d
-                ay += f * dy / d
-            # -- robot --
-            dx = x - robot_xy[w, 0]
-            dy = y - robot_xy[w, 1]
-            d = math.hypot(dx, dy)
-            if 1e-9 < d < cutoff:
-                f = a_r * math.exp((ra + robot_r[w] - d) / b_r)
-                ax += f * dx / d
-                ay += f * dy / d
-            # -- walls --
-            dw = _wall_distance(distg, rs, gx0, gy0, x, y)
-            if dw < cutoff:
-                nx, ny = _wall_gradient(distg, rs, gx0, gy0, x, y)
-                f = a_w * math.exp((ra - dw) / b_w)
-                ax += f * nx
-                ay += f * ny
-            # -- obstacle edges --
-            for s in range(s_n):
-                qx, qy = seg_a[w, s, 0], seg_a[w, s, 1]
-                ex = seg_b[w, s, 0] - qx
-                ey = seg_b[w, s, 1] - qy
-                ee = ex * ex + ey * ey
-                t = ((x - qx) * ex + (y - qy) * ey) / ee if ee > 0.0 else 0.0
-                t = min(max(t, 0.0), 1.0)
-                dx = x - qx - t * ex
-                dy = y - qy - t * ey
-                d = math.hypot(dx, dy)
-                if 1e-9 < d < cutoff:
-                    f = a_w * math.exp((ra - d) / b_w)
-                    ax += f * dx / d
-                    ay += f * dy / d
-            # -- integrate --
-            nvx = vx + ax * dt
-            nvy = vy + ay * dt
-            sp = math.hypot(nvx, nvy)
-            cap = vfac * vmax[w, a]
-            if sp > cap:
-                nvx *= cap / sp
-                nvy *= cap / sp
-            nx_ = x + nvx * dt
-            ny_ = y + nvy * dt
-            dw_new = _wall_distance(distg, rs, gx0, gy0, nx_, ny_)
-            if dw_new == 0.0 or (dw_new < ra and dw_new < dw):
-                nx_, ny_, nvx, nvy = x, y, 0.0, 0.0
-            out_pos[w, a, 0] = nx_
-            out_pos[w, a, 1] = ny_
-            out_vel[w, a, 0] = nvx
-            out_vel[w, a, 1] = nvy
-            if math.hypot(nvx, nvy) > 0.05:
-                heading[w, a] = math.atan2(nvy, nvx)
+        _crowd_worlds_one(
+            w, active, pos, vel, heading, radii, vmax, ped_n, wps, n_wp, wp_mode, wp_idx, rand,
+            rand_k, dist_flat, offs, shapes, res, origin, seg_a, seg_b, seg_n, robot_xy, robot_r,
+            prm, dt, out_pos, out_vel,
+        )
+
+
+@njit(cache=True)
+def crowd_worlds_serial(
+    active: B1, pos: F64, vel: F64, heading: F64, radii: F64, vmax: F64, ped_n: I64,
+    wps: F64, n_wp: I64, wp_mode: I64, wp_idx: I64, rand: F64, rand_k: I64,
+    dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
+    seg_a: F64, seg_b: F64, seg_n: I64, robot_xy: F64, robot_r: F64,
+    prm: F64, dt: float, out_pos: F64, out_vel: F64,
+) -> None:
+    """:func:`crowd_worlds` on the calling thread (no thread-pool launch: small ``N``)."""
+    for w in range(pos.shape[0]):
+        _crowd_worlds_one(
+            w, active, pos, vel, heading, radii, vmax, ped_n, wps, n_wp, wp_mode, wp_idx, rand,
+            rand_k, dist_flat, offs, shapes, res, origin, seg_a, seg_b, seg_n, robot_xy, robot_r,
+            prm, dt, out_pos, out_vel,
+        )

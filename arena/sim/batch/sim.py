@@ -41,6 +41,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
@@ -156,6 +157,9 @@ class BatchSim:
             "social_force", description="batched social force, or standing at their spawn"
         )
         crowd: BatchCrowdParams = Field(default_factory=BatchCrowdParams)
+        parallel_min_worlds: int = Field(
+            2, ge=1, description="kernels use numba's thread pool from this many worlds on"
+        )
         robot_radius: float | None = Field(
             None, gt=0, description="m, contact circle; None: the robot's circumscribed radius"
         )
@@ -195,6 +199,8 @@ class BatchSim:
         self._step = np.zeros(n, dtype=np.int64)
         self._last_scan = np.full(n, -math.inf)
         self._scans = np.zeros((n, 1))
+        self._scratch_f = np.zeros((n, 5, 0))  # per-world lidar work arrays (_set_spec sizes)
+        self._scratch_i = np.zeros((n, 2, 0), dtype=np.int64)
         self._wall = np.zeros(n, dtype=bool)
         self._obstacle = np.full(n, -1, dtype=np.int64)
         self._agent = np.full(n, -1, dtype=np.int64)
@@ -227,13 +233,27 @@ class BatchSim:
             raise SimulationError("BatchSim has not been reset yet")
         return self._spec
 
-    def reset(self, episodes: Sequence[Episode], rng: np.random.Generator) -> BatchState:
-        """Start ``N`` episodes; world ``i`` gets ``episodes[i]`` and ``rng.spawn(N)[i]``."""
+    def reset(
+        self,
+        episodes: Sequence[Episode],
+        rng: np.random.Generator | Sequence[np.random.Generator],
+    ) -> BatchState:
+        """Start ``N`` episodes; world ``i`` gets ``episodes[i]`` and ``rng.spawn(N)[i]``.
+
+        ``rng`` may also be a sequence of ``N`` generators, one per world (then a world's
+        stream does not depend on ``N``).
+        """
         if len(episodes) != self.num_worlds:
             raise SimulationError(f"need {self.num_worlds} episodes, got {len(episodes)}")
+        if isinstance(rng, np.random.Generator):
+            rngs: Sequence[np.random.Generator] = rng.spawn(self.num_worlds)
+        else:
+            rngs = rng
+            if len(rngs) != self.num_worlds:
+                raise SimulationError(f"need {self.num_worlds} generators, got {len(rngs)}")
         self._spec = None
         self._ensure_capacity(episodes)
-        for i, (ep, child) in enumerate(zip(episodes, rng.spawn(self.num_worlds), strict=True)):
+        for i, (ep, child) in enumerate(zip(episodes, rngs, strict=True)):
             self._load(i, ep, child)
         self._scan(np.ones(self.num_worlds, dtype=bool))
         self._contacts(sweep=False)
@@ -262,6 +282,35 @@ class BatchSim:
         only[i] = True
         self._scan(only)
         self._contacts(sweep=False, only=i)
+        return self._snapshot()
+
+    def reset_worlds(
+        self,
+        indices: Sequence[int] | I64,
+        episodes: Sequence[Episode],
+        rngs: Sequence[np.random.Generator],
+    ) -> BatchState:
+        """Restart several worlds at once (one scan and one snapshot for all of them).
+
+        World ``indices[j]`` gets ``episodes[j]`` and ``rngs[j]``; the others are untouched.
+        """
+        idx = [int(i) for i in indices]
+        if not (len(idx) == len(episodes) == len(rngs)):
+            raise SimulationError("indices, episodes and rngs must have the same length")
+        if self._spec is None:
+            raise SimulationError("reset_worlds() called before reset()")
+        if not idx:
+            return self._snapshot()
+        for i in idx:
+            if not 0 <= i < self.num_worlds:
+                raise SimulationError(f"no world {i}: worlds are 0..{self.num_worlds - 1}")
+        self._ensure_capacity(episodes)
+        for i, ep, rng in zip(idx, episodes, rngs, strict=True):
+            self._load(i, ep, rng)
+        only = np.zeros(self.num_worlds, dtype=bool)
+        only[idx] = True
+        self._scan(only)
+        self._contacts(sweep=False, mask=only)
         return self._snapshot()
 
     def step(self, commands: F64, dt: float) -> BatchState:
@@ -300,7 +349,8 @@ class BatchSim:
             return
         out_pos = np.empty_like(self._pos)
         out_vel = np.empty_like(self._vel)
-        K.crowd_worlds(
+        kernel = K.crowd_worlds if self._parallel(self.num_worlds) else K.crowd_worlds_serial
+        kernel(
             np.ones(self.num_worlds, dtype=bool), self._pos, self._vel, self._heading,
             self._pradii, self._vmax, self._ped_n, self._wps, self._n_wp, self._wp_mode,
             self._wp_idx, self._rand, self._rand_k,
@@ -328,19 +378,25 @@ class BatchSim:
         return new_p, new_t, new_s
 
     def _contacts(
-        self, sweep: bool, previous: F64 | None = None, only: int | None = None
+        self, sweep: bool, previous: F64 | None = None, only: int | None = None,
+        mask: NDArray[np.bool_] | None = None,
     ) -> None:
         prev = self._poses if previous is None else previous
         wall = np.zeros(self.num_worlds, dtype=bool)
         obstacle = np.full(self.num_worlds, -1, dtype=np.int64)
         agent = np.full(self.num_worlds, -1, dtype=np.int64)
-        K.contacts_worlds(
+        kernel = K.contacts_worlds if self._parallel(self.num_worlds) else K.contacts_worlds_serial
+        kernel(
             self._poses, prev, sweep, self._radius,
             self._dist, self._offs, self._shapes, self._res, self._origin,
             self._seg_a, self._seg_b, self._seg_owner, self._seg_n,
             self._pos, self._pradii, self._ped_n, wall, obstacle, agent,
         )
-        if only is None:
+        if mask is not None:
+            self._wall[mask], self._obstacle[mask], self._agent[mask] = (
+                wall[mask], obstacle[mask], agent[mask]
+            )
+        elif only is None:
             self._wall, self._obstacle, self._agent = wall, obstacle, agent
         else:
             self._wall[only], self._obstacle[only], self._agent[only] = (
@@ -352,12 +408,13 @@ class BatchSim:
         if not self.params.lidar or not due.any():
             return
         self._last_scan[due] = self._time[due]
-        K.scan_worlds(
+        kernel = K.scan_worlds if self._parallel(int(due.sum())) else K.scan_worlds_serial
+        kernel(
             due, self._poses, self._mount, self._cos, self._sin, spec.angle_min, self._inc,
             spec.range_min, spec.range_max,
             self._dist, self._offs, self._shapes, self._res, self._origin,
             self._pos, self._pradii, self._ped_n, self._seg_a, self._seg_b, self._seg_n,
-            self._scans,
+            self._scans, self._scratch_f, self._scratch_i,
         )
         if spec.noise_std > 0.0:
             for i in np.flatnonzero(due):
@@ -368,6 +425,13 @@ class BatchSim:
                 _add_noise(row, z, spec.noise_std, spec.range_min, spec.range_max)
 
     # -- internals -------------------------------------------------------------------------------
+    def _parallel(self, worlds: int) -> bool:
+        """Run a kernel over ``worlds`` worlds on the thread pool (else on the calling thread).
+
+        A pool launch costs tens of µs (more on busy cores), more than one world's work.
+        """
+        return worlds >= self.params.parallel_min_worlds and numba.get_num_threads() > 1
+
     def _alloc_peds(self, p: int, k: int) -> None:
         n = self.num_worlds
         self._pos = np.zeros((n, p, 2))
@@ -509,6 +573,10 @@ class BatchSim:
         self._mount = np.asarray(spec.mount, dtype=np.float64)
         if self._scans.shape[1] != spec.num_beams:
             self._scans = np.full((self.num_worlds, spec.num_beams), spec.range_max)
+        b = spec.num_beams
+        if self._scratch_f.shape[2] != b:
+            self._scratch_f = np.zeros((self.num_worlds, 5, b))
+            self._scratch_i = np.zeros((self.num_worlds, 2, b), dtype=np.int64)
 
     def _regroup(self) -> None:
         """Group the worlds by kinematics parameters (one vectorised call per group)."""
