@@ -17,6 +17,7 @@ $(STAMP): pyproject.toml | $(PY)
 	touch $@
 
 $(TEST_STAMP): pyproject.toml | $(PY)
+	$(PY) -m pip install --quiet torch==2.13.0  # first: the CPU build, before SB3 asks for torch
 	$(PY) -m pip install --quiet -e ".[test]"
 	touch $@ $(STAMP)
 

@@ -454,6 +454,77 @@ def bench(
         _write_report(run, None, videos=1, workers=workers)
 
 
+
+@app.command()
+def train(
+    config: Annotated[
+        str | None,
+        typer.Argument(help="experiment YAML (default: the packaged default; resume: the run's)"),
+    ] = None,
+    overrides: Annotated[
+        list[str] | None,
+        typer.Argument(help="dotted overrides, e.g. learning.ppo.n_epochs=5 seed=3"),
+    ] = None,
+    out: Annotated[Path | None, typer.Option("--out", "-o", help="run folder")] = None,
+    resume: Annotated[
+        Path | None, typer.Option("--resume", help="continue the run in this folder")
+    ] = None,
+    steps: Annotated[
+        int | None, typer.Option("--steps", min=1, help="total env steps (learning.train)")
+    ] = None,
+    envs: Annotated[
+        int | None, typer.Option("--envs", min=1, help="parallel envs (learning.train.n_envs)")
+    ] = None,
+    progress: Annotated[
+        bool, typer.Option("--progress/--no-progress", help="show a progress bar")
+    ] = True,
+) -> None:
+    r"""Train a PPO policy on arena/SocialNav-v0 (pip install 'arena\[train]').
+
+    Writes checkpoints, TensorBoard logs, ``run.json`` and the final ``policy.npz`` (for the
+    ``rosnav_rl`` local planner) into the run folder; ``--resume RUN_DIR`` continues a run.
+    """
+    # before numba/OpenMP start threads: idle workers sleep instead of spinning, so that the
+    # batched simulator's parallel loops do not steal cores from torch (see arena.sim.batch)
+    os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+    from datetime import datetime
+
+    from arena.config.schema import ExperimentConfig
+    from arena.learn.train import load_training, read_run, require_sb3, summary
+    from arena.learn.train import train as run_training
+    from arena.learn.train_config import TrainSettings
+
+    require_sb3()
+    items = ([config] if config else []) + list(overrides or [])
+    path = None
+    if items and "=" not in items[0]:
+        path, items = items[0], items[1:]
+    if resume is not None and out is not None and resume.resolve() != out.resolve():
+        raise ArenaError("give either --resume RUN_DIR or -o RUN_DIR, not two different folders")
+    if resume is not None and path is None and not items:
+        manifest = read_run(resume)
+        cfg = ExperimentConfig.model_validate(manifest["config"])
+        settings = TrainSettings.model_validate(manifest["settings"])
+    else:
+        cfg, settings = load_training(path, items)
+    update = {}
+    if steps is not None:
+        update["total_steps"] = steps
+    if envs is not None:
+        update["n_envs"] = envs
+    if update:
+        settings = settings.model_copy(update={"train": settings.train.model_copy(update=update)})
+    run_dir = resume or out
+    if run_dir is None:
+        run_dir = Path("runs") / f"train_{cfg.name}_{datetime.now().strftime('%y-%m-%d_%H-%M-%S')}"
+    console.print(
+        f"[bold]train[/] {cfg.robot} · {settings.train.total_steps} steps · "
+        f"{settings.train.n_envs} env(s) · seed "
+        f"{settings.train.seed if settings.train.seed is not None else cfg.seed} → {run_dir}"
+    )
+    result = run_training(cfg, settings, run_dir, resume=resume is not None, progress=progress)
+    console.print(summary(result))
+
 #: Columns of the per-contestant table ``arena bench`` prints: (metric, header, format).
 _BENCH_COLUMNS = (
     ("success", "success", "{:.0%}"),  # headers fit an 80-column terminal

@@ -11,6 +11,7 @@ One experiment YAML drives both ``arena run`` and :class:`~arena.learn.env.Socia
           laser_stack: 1
           pedestrians: {enabled: true, k: 5, max_range: 8.0}
           semantic: {enabled: false, size: 80, roi: 20.0, channels: [pedestrian_location]}
+          subgoal: {enabled: false, horizon: 5.0, replan_period: 1.0}
         action: {type: discrete, discretization: robot}
         reward: default                # a packaged file (arena/learn/data/rewards/) or a mapping
         action_period: null            # s; null = sim.dt (one simulation step per env step)
@@ -28,6 +29,8 @@ from __future__ import annotations
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
+
+from arena.learn.train_config import PPOConfig, TrainConfig
 
 SemanticChannel = Literal[
     "pedestrian_location",
@@ -65,6 +68,23 @@ class SemanticObsConfig(_Strict):
     )
 
 
+class SubgoalObsConfig(_Strict):
+    """Arena's "spacial horizon" (arena_specs §8.1): the goal observation refers to a subgoal.
+
+    At reset a global path is planned (A* on the episode's planning grid, inflated by the robot
+    radius + ``navigation.inflation_margin`` as the navigation stack does); each step the
+    ``goal`` observation is ``[ρ, θ]`` of :func:`~arena.learn.observations.subgoal_on_path`.
+    Rewards keep using the final goal.
+    """
+
+    enabled: bool = Field(False, description="'goal' observes the subgoal, not the final goal")
+    horizon: float = Field(5.0, gt=0, description="m ahead along the path (Arena: 5.0)")
+    replan_period: float = Field(1.0, gt=0, description="s between global replans (Arena: 1.0)")
+    max_deviation: float = Field(
+        1.0, gt=0, description="m; replan at once when the robot is farther from the path"
+    )
+
+
 class ObservationConfig(_Strict):
     """Which observation parts the environment returns."""
 
@@ -77,6 +97,7 @@ class ObservationConfig(_Strict):
     )
     pedestrians: PedestrianObsConfig = Field(default_factory=PedestrianObsConfig)
     semantic: SemanticObsConfig = Field(default_factory=SemanticObsConfig)
+    subgoal: SubgoalObsConfig = Field(default_factory=SubgoalObsConfig)
     flatten: bool = Field(False, description="one flat float32 Box instead of a Dict space")
 
 
@@ -129,3 +150,5 @@ class LearningConfig(_Strict):
     """The ``learning`` block of an experiment."""
 
     env: EnvConfig = Field(default_factory=EnvConfig)
+    ppo: PPOConfig = Field(default_factory=PPOConfig, description="PPO (arena train)")
+    train: TrainConfig = Field(default_factory=TrainConfig, description="arena train run")

@@ -20,18 +20,27 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import ndimage
 
 import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.loader import load_config
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ConfigError
+from arena.core.errors import ConfigError, PlanningError, StartOccupied
 from arena.core.rng import derive_rng
-from arena.core.types import Outcome
+from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
 from arena.learn.actions import ActionDecoder
-from arena.learn.config import EnvConfig
-from arena.learn.observations import Obs, ObservationBuilder, ObsInput
+from arena.learn.config import EnvConfig, SubgoalObsConfig
+from arena.learn.observations import (
+    Obs,
+    ObservationBuilder,
+    ObsInput,
+    project_on_path,
+    subgoal_on_path,
+)
 from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput
+from arena.maps.raster import polygon_mask
+from arena.nav.global_planners.astar import AStarPlanner
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.sim.backend import BACKENDS, SimulatorBackend
@@ -80,6 +89,95 @@ class StepResult:
     outcomes: list[str | None]
 
 
+_SUCCESS = int(DoneReason.SUCCESS)
+_COLLISION = int(DoneReason.COLLISION)
+_OUT_SUCCESS = Outcome.SUCCESS.value
+_OUT_COLLISION = Outcome.COLLISION.value
+_OUT_TIMEOUT = Outcome.TIMEOUT.value
+
+
+def planning_grid(episode: Episode) -> Any:
+    """The map with the known static obstacles burnt in (:func:`arena.experiment.planning_grid`)."""
+    if not episode.obstacles:
+        return episode.grid
+    return episode.grid.with_occupied(
+        polygon_mask(episode.grid, [o.polygon for o in episode.obstacles])
+    )
+
+
+class SubgoalTracker:
+    """Global paths and subgoals of ``r`` robots (Arena's "spacial horizon", arena_specs §8.1).
+
+    At :meth:`reset` the planning grid is inflated by ``inscribed`` m (robot radius +
+    ``navigation.inflation_margin``, as the navigation stack does) and an A* path planned per
+    robot; :meth:`update` replans every ``replan_period`` s and whenever a robot is more than
+    ``max_deviation`` m from its path, then moves each subgoal to
+    :func:`~arena.learn.observations.subgoal_on_path`. A robot whose start lies in the
+    inflated zone plans from the nearest free cell (its position prepended); when no path exists
+    the straight segment to the goal stands in, so an episode never fails for want of a plan.
+    """
+
+    def __init__(self, cfg: SubgoalObsConfig, inscribed: float, n_robots: int) -> None:
+        self.cfg = cfg
+        self.inscribed = float(inscribed)
+        self.planner = AStarPlanner()
+        self.paths: list[FloatArray] = [np.zeros((1, 2))] * n_robots
+        self.current = np.zeros((n_robots, 2))
+        self.plan_time = np.zeros(n_robots)
+        self.grid: Any = None
+        self._nearest: Any = None
+
+    def reset(self, grid: Any, poses: FloatArray, goals: FloatArray, time: float) -> None:
+        """Inflate ``grid`` and plan from each pose to its goal."""
+        self.grid = grid
+        self.inflated = grid.inflate(self.inscribed)
+        self._nearest = None
+        for i in range(poses.shape[0]):
+            self._replan(i, poses[i], goals[i], time)
+        self._subgoals(poses, goals)
+
+    def update(self, poses: FloatArray, goals: FloatArray, time: float) -> None:
+        """Replan where due or strayed; move the subgoals."""
+        for i in range(poses.shape[0]):
+            due = time - self.plan_time[i] >= self.cfg.replan_period - 1e-9
+            if due or project_on_path(self.paths[i], poses[i, :2])[1] > self.cfg.max_deviation:
+                self._replan(i, poses[i], goals[i], time)
+        self._subgoals(poses, goals)
+
+    def _subgoals(self, poses: FloatArray, goals: FloatArray) -> None:
+        for i in range(poses.shape[0]):
+            self.current[i] = subgoal_on_path(self.paths[i], poses[i, :2], self.cfg.horizon)
+
+    def _replan(self, i: int, pose: FloatArray, goal: FloatArray, time: float) -> None:
+        self.plan_time[i] = time
+        start = Pose2D(float(pose[0]), float(pose[1]), float(pose[2]))
+        end = Pose2D(float(goal[0]), float(goal[1]), 0.0)
+        path: FloatArray | None
+        try:
+            path = self.planner.plan(self.inflated, start, end)
+        except StartOccupied:
+            path = self._plan_via_free_cell(start, end)
+        except PlanningError:
+            path = None
+        if path is None:
+            path = np.array([pose[:2], goal[:2]], dtype=np.float64)
+        self.paths[i] = np.asarray(path, dtype=np.float64)
+
+    def _plan_via_free_cell(self, start: Pose2D, end: Pose2D) -> FloatArray | None:
+        grid = self.inflated
+        cell = grid.world_to_cell(start.xy)
+        if not bool(grid.in_bounds(cell)) or bool(grid.occupied.all()):
+            return None
+        if self._nearest is None:
+            self._nearest = ndimage.distance_transform_edt(grid.occupied, return_indices=True)[1]
+        free = grid.cell_to_world(self._nearest[:, int(cell[0]), int(cell[1])])
+        try:
+            path = self.planner.plan(grid, Pose2D(float(free[0]), float(free[1]), 0.0), end)
+        except PlanningError:
+            return None
+        return np.vstack([start.xy[None, :], path])
+
+
 class EpisodeDriver:
     """``r`` robots of one model in one world, stepped together.
 
@@ -115,6 +213,11 @@ class EpisodeDriver:
         self.goals = np.zeros((r, 3))
         self.active = np.ones(r, dtype=bool)
         self.radius = float(self.robot.radius)
+        self._consts: dict[str, Any] = {}
+        self.subgoal_cfg = self.env_cfg.observation.subgoal
+        self.subgoals = SubgoalTracker(
+            self.subgoal_cfg, self.radius + float(cfg.navigation.inflation_margin), r
+        ) if self.subgoal_cfg.enabled else None
 
     def _generator(self, seed: int) -> TaskGenerator:
         cfg = self.cfg.model_copy(update={"seed": int(seed)})
@@ -142,6 +245,19 @@ class EpisodeDriver:
         self.active[:] = True
         self.scans[:] = np.stack(self.state.robots.scans)[:, None, :]
         self._renderer: Any = None  # drawn lazily, once per episode (the world changes)
+        # per-episode constants of the reward input (allocated once, never written to)
+        r = self.n_robots
+        self._consts = {
+            "goal_jump": np.zeros(r),
+            "goal_radius": np.full(r, ep.goal_radius),
+            "robot_radius": np.full(r, self.radius),
+            "safe_dist": np.full(r, self.radius + self.env_cfg.safety_distance),
+            "dt": np.full(r, self.period),
+            "max_steps": np.full(r, self.env_cfg.max_steps, dtype=np.int64),
+            "no_range": np.full(r, np.inf),
+        }
+        if self.subgoals is not None:
+            self.subgoals.reset(planning_grid(ep), self.state.robots.poses, self.goals, 0.0)
         return self.obs_builder.build(self._obs_input())
 
     def _peds(self) -> tuple[FloatArray, FloatArray, Any, Any, Any]:
@@ -149,6 +265,12 @@ class EpisodeDriver:
         a = self.state.agents
         r = self.n_robots
         m = len(a)
+        if r == 1:  # views with a leading axis of one (cheaper than broadcast_to)
+            return (
+                np.asarray(a.positions)[None], np.asarray(a.velocities)[None],
+                np.asarray(a.kinds)[None], np.asarray(a.states)[None],
+                np.ones((1, m), dtype=bool),
+            )
         return (
             np.broadcast_to(a.positions, (r, m, 2)),
             np.broadcast_to(a.velocities, (r, m, 2)),
@@ -161,8 +283,9 @@ class EpisodeDriver:
         assert self.state is not None
         pos, vel, kind, st, mask = self._peds()
         rs = self.state.robots
+        goals = self.goals[:, :2] if self.subgoals is None else self.subgoals.current
         return ObsInput(
-            poses=rs.poses, twists=rs.twists, goals=self.goals[:, :2], scans=self.scans,
+            poses=rs.poses, twists=rs.twists, goals=goals, scans=self.scans,
             last_action=self.last_action, ped_pos=pos, ped_vel=vel, ped_kind=kind,
             ped_state=st, ped_mask=mask,
         )
@@ -182,44 +305,56 @@ class EpisodeDriver:
         assert self.episode is not None
         cmd = self.decoder.decode(actions)
         cmd[~self.active] = 0.0
-        prev_pose = self.state.robots.poses.copy()
+        prev_heading = self.state.robots.poses[:, 2].copy()
         prev_dist = self.goal_distance()
-        collision = np.zeros(self.n_robots, dtype=bool)
-        for _ in range(self.substeps):
+        if self.substeps == 1:
             self.state = self.backend.step(cmd, self.dt)
-            collision |= self.state.collisions.any
+            collision = np.array(self.state.collisions.any, dtype=bool)
+        else:
+            collision = np.zeros(self.n_robots, dtype=bool)
+            for _ in range(self.substeps):
+                self.state = self.backend.step(cmd, self.dt)
+                collision |= self.state.collisions.any
         self.steps += 1
         scans = np.stack(self.state.robots.scans)
-        self.scans = np.concatenate([self.scans[:, 1:], scans[:, None, :]], axis=1)
+        if self.scans.shape[1] == 1:
+            self.scans = scans[:, None, :]
+        else:
+            self.scans = np.concatenate([self.scans[:, 1:], scans[:, None, :]], axis=1)
+        poses = self.state.robots.poses
         dist = self.goal_distance()
         goal_reached = dist < self.episode.goal_radius
         r = self.n_robots
+        c = self._consts
         pos, _, kind, _, mask = self._peds()
-        ped_d = np.hypot(*(pos - self.state.robots.poses[:, None, :2]).transpose(2, 0, 1))
+        d = pos - poses[:, None, :2]
+        ped_d = np.hypot(d[..., 0], d[..., 1])
         inp = RewardInput(
             action=cmd,
-            prev_action=self.last_action.copy(),
+            prev_action=self.last_action,  # replaced below, never written to
             goal_distance=dist,
             prev_goal_distance=prev_dist,
-            goal_jump=np.zeros(r),
-            goal_radius=np.full(r, self.episode.goal_radius),
+            goal_jump=c["goal_jump"],
+            goal_radius=c["goal_radius"],
             goal_reached=goal_reached,
-            min_range=scans.min(axis=1) if scans.shape[1] else np.full(r, np.inf),
-            robot_radius=np.full(r, self.radius),
-            safe_dist=np.full(r, self.radius + self.env_cfg.safety_distance),
+            min_range=scans.min(axis=1) if scans.shape[1] else c["no_range"],
+            robot_radius=c["robot_radius"],
+            safe_dist=c["safe_dist"],
             collision=collision,
-            heading=self.state.robots.poses[:, 2].copy(),
-            prev_heading=prev_pose[:, 2],
-            dt=np.full(r, self.period),
+            heading=poses[:, 2].copy(),
+            prev_heading=prev_heading,
+            dt=c["dt"],
             step=np.full(r, self.steps, dtype=np.int64),
-            max_steps=np.full(r, self.env_cfg.max_steps, dtype=np.int64),
+            max_steps=c["max_steps"],
             ped_distance=ped_d,
-            ped_kind=np.asarray(kind, dtype=np.int64),
-            ped_mask=np.asarray(mask),
+            ped_kind=kind if kind.dtype == np.int64 else kind.astype(np.int64),
+            ped_mask=mask,
         )
         out = self.reward_fn(inp)
         self.last_action = cmd
-        term_reason = (out.reason == DoneReason.SUCCESS) | (out.reason == DoneReason.COLLISION)
+        reason = out.reason
+        hit = reason == _COLLISION
+        term_reason = (reason == _SUCCESS) | hit
         terminated = goal_reached | collision | (out.done & term_reason)
         limit = (self.steps >= self.env_cfg.max_steps) or (
             self.state.time >= self.episode.time_limit - 1e-9
@@ -227,14 +362,16 @@ class EpisodeDriver:
         truncated = ~terminated & (limit | (out.done & ~term_reason))
         outcomes: list[str | None] = []
         for i in range(r):
-            if collision[i] or out.reason[i] == DoneReason.COLLISION:
-                outcomes.append(Outcome.COLLISION.value)
+            if collision[i] or hit[i]:
+                outcomes.append(_OUT_COLLISION)
             elif terminated[i]:
-                outcomes.append(Outcome.SUCCESS.value)
+                outcomes.append(_OUT_SUCCESS)
             elif truncated[i]:
-                outcomes.append(Outcome.TIMEOUT.value)
+                outcomes.append(_OUT_TIMEOUT)
             else:
                 outcomes.append(None)
+        if self.subgoals is not None:
+            self.subgoals.update(poses, self.goals, self.state.time)
         obs = self.obs_builder.build(self._obs_input())
         return StepResult(obs, out, goal_reached, collision, terminated, truncated, dist, outcomes)
 
@@ -259,7 +396,7 @@ class EpisodeDriver:
         assert self.state is not None
         assert self.episode is not None
         return {
-            "episode": self.episode.index,
+            "episode_index": self.episode.index,
             "time": float(self.state.time),
             "steps": self.steps,
             "goal_distance": float(self.goal_distance()[i]),

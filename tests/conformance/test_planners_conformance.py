@@ -11,6 +11,8 @@ from __future__ import annotations
 import copy
 import itertools
 import math
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -119,6 +121,63 @@ def test_global_planner_typed_failures(global_name: str) -> None:
 
 # -- local planners --------------------------------------------------------------------------------
 
+RANDOM_POLICY = "<random_policy>"
+PLANNER_PARAMS: dict[str, dict[str, Any]] = {
+    # no packaged weights needed: an untrained policy in the export layout (made without torch)
+    "rosnav_rl": {"weights": RANDOM_POLICY},
+}
+"""Parameters (besides ``type``) each local planner is built with."""
+
+
+def _free_road_obs(kin: str) -> LocalObservation:
+    return LocalObservation(
+        pose=np.zeros(3),
+        twist=np.zeros(3),
+        goal=Pose2D(3.0, 0.0),
+        path=np.array([[0, 0], [3, 0]]),
+        limits=LIMITS[kin],
+        robot_radius=0.3,
+        dt=DT,
+        kinematics=kin,
+    )
+
+
+@pytest.fixture(scope="session")
+def random_policy_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A random rosnav_rl policy (jackal, lidar + goal + last_action) that drives forward.
+
+    The first seed whose untrained policy moves toward a free-road goal ahead is kept, so that
+    :func:`test_local_planner_without_scan` checks the plumbing, not luck.
+    """
+    from arena.learn.config import EnvConfig
+    from arena.learn.policy import write_random_policy
+    from arena.nav.local_planners.learned import LearnedPlanner
+    from arena.robots.presets import load_robot
+
+    env = EnvConfig.model_validate({"observation": {"pedestrians": {"enabled": False}}})
+    robot = load_robot("jackal")
+    folder = tmp_path_factory.mktemp("policies")
+    for seed in range(100):
+        path = write_random_policy(folder / f"random_{seed}.npz", env, robot, rng=seed)
+        planner = LearnedPlanner(LearnedPlanner.Params(weights=str(path)))
+        if all(planner.compute(_free_road_obs(k))[0] > 0 for k in sorted(planner.supports)):
+            return path
+    raise AssertionError("no random policy drives forward")
+
+
+@pytest.fixture
+def local_spec(request: pytest.FixtureRequest) -> Any:
+    """``name -> {"type": name, **PLANNER_PARAMS[name]}`` (random weights resolved)."""
+
+    def spec(name: str) -> dict[str, Any]:
+        params = dict(PLANNER_PARAMS.get(name, {}))
+        for k, v in params.items():
+            if v == RANDOM_POLICY:
+                params[k] = str(request.getfixturevalue("random_policy_file"))
+        return {"type": name, **params}
+
+    return spec
+
 
 def _cases() -> list[tuple[str, str]]:
     return [
@@ -164,9 +223,9 @@ def _snapshot(obs: LocalObservation) -> dict[str, np.ndarray]:
 
 
 @pytest.mark.parametrize(("name", "kin"), _cases())
-def test_local_planner_conformance(name: str, kin: str) -> None:
+def test_local_planner_conformance(name: str, kin: str, local_spec: Any) -> None:
     assert kin in KINEMATICS
-    planner = LOCAL_PLANNERS.build({"type": name})
+    planner = LOCAL_PLANNERS.build(local_spec(name))
     assert isinstance(planner, LocalPlanner)
     assert planner.supports <= KINEMATICS
     rng = np.random.default_rng(12345)
@@ -198,25 +257,15 @@ def test_local_planner_conformance(name: str, kin: str) -> None:
     planner.reset()
     for obs, cmd in zip(observations, first, strict=True):
         np.testing.assert_array_equal(planner.compute(obs), cmd)
-    other = LOCAL_PLANNERS.build({"type": name})
+    other = LOCAL_PLANNERS.build(local_spec(name))
     for obs, cmd in zip(observations, first, strict=True):
         np.testing.assert_array_equal(other.compute(obs), cmd)
 
 
 @pytest.mark.parametrize(("name", "kin"), _cases())
-def test_local_planner_without_scan(name: str, kin: str) -> None:
-    planner = LOCAL_PLANNERS.build({"type": name})
-    lim = LIMITS[kin]
-    obs = LocalObservation(
-        pose=np.zeros(3),
-        twist=np.zeros(3),
-        goal=Pose2D(3.0, 0.0),
-        path=np.array([[0, 0], [3, 0]]),
-        limits=lim,
-        robot_radius=0.3,
-        dt=DT,
-        kinematics=kin,
-    )
+def test_local_planner_without_scan(name: str, kin: str, local_spec: Any) -> None:
+    planner = LOCAL_PLANNERS.build(local_spec(name))
+    obs = _free_road_obs(kin)
     cmd = planner.compute(obs)
     assert cmd.shape == (3,) and np.all(np.isfinite(cmd))
     assert cmd[0] > 0  # free road ahead: it moves toward the goal

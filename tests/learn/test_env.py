@@ -74,10 +74,10 @@ def test_same_seed_same_actions_same_rollout():
 def test_episode_index_advances_and_seed_restarts():
     env = SocialNavEnv(small_cfg(), robot=small_robot())
     _, info = env.reset(seed=1)
-    assert info["episode"] == 0
-    assert env.reset()[1]["episode"] == 1
-    assert env.reset(options={"episode": 5})[1]["episode"] == 5
-    assert env.reset(seed=1)[1]["episode"] == 0
+    assert info["episode_index"] == 0
+    assert env.reset()[1]["episode_index"] == 1
+    assert env.reset(options={"episode": 5})[1]["episode_index"] == 5
+    assert env.reset(seed=1)[1]["episode_index"] == 0
 
 
 def test_truncates_at_max_steps_with_timeout_outcome():

@@ -377,9 +377,11 @@ class PySocialModel:
                 terms["group_gaze"] *= p.group_gaze_factor
 
         acc = np.zeros((n, 2))
+        inactive = None if active.all() else ~active
         for k in TERMS:
             f = terms[k]
-            f[~active] = 0.0
+            if inactive is not None:
+                f[inactive] = 0.0
             if p.force_scale != 1.0:
                 f *= p.force_scale
             acc += f
@@ -535,7 +537,7 @@ def group_members(group: IntArray) -> tuple[IntArray, IntArray]:
         return np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64)
     order = grouped[np.argsort(g[grouped], kind="stable")]
     ids = g[order]
-    starts = np.r_[0, np.flatnonzero(np.diff(ids)) + 1, ids.size].astype(np.int64)
+    starts = np.concatenate(([0], np.flatnonzero(np.diff(ids)) + 1, [ids.size])).astype(np.int64)
     return order.astype(np.int64), starts
 
 

@@ -73,7 +73,19 @@ TARGET_AGENT = 1
 TARGET_ROBOT = 2
 TARGET_POINT = 3
 
-_S = SocialState
+
+class _S:
+    """:class:`SocialState` codes as plain ints (an enum member lookup costs ~1 µs on 3.11)."""
+
+    IDLE = int(SocialState.IDLE)
+    WALKING = int(SocialState.WALKING)
+    RUNNING = int(SocialState.RUNNING)
+    INTERACTING = int(SocialState.INTERACTING)
+    TALKING = int(SocialState.TALKING)
+    PHONE = int(SocialState.PHONE)
+    PANIC = int(SocialState.PANIC)
+
+
 _N_STATES = 7
 # Per-state level rates come from these parameter prefixes; PANIC lasts one tick and uses the
 # running rates (Arena has no panic rates: the panic state is left at once).

@@ -1,0 +1,528 @@
+"""``N`` social-navigation worlds as one Gymnasium vector environment, stepped by :class:`BatchSim`.
+
+:class:`BatchedSocialNavEnv` is the vectorised counterpart of
+:class:`~arena.learn.env.SocialNavEnv`: the same observation and action spaces (built by
+:class:`~arena.learn.observations.ObservationBuilder` and
+:class:`~arena.learn.actions.ActionDecoder`), the same reward terms
+(:class:`~arena.learn.rewards.RewardFunction`) and the same episode-end rules (terminated on goal
+or collision, truncated after ``max_steps`` env steps or the episode's time limit), all from the
+same :class:`~arena.config.schema.ExperimentConfig`. Every part of an env step runs on arrays
+with a leading world axis; there is one :meth:`BatchSim.step` call per simulation sub-step for
+all worlds, and no Python loop over worlds except to draw the episodes of worlds that restart.
+
+Differences from ``SocialNavEnv`` (they come from the simulator, see :mod:`arena.sim.batch`):
+pedestrians follow the batched social force (not ``cfg.crowd``), and contacts use the robot's
+circumscribed circle, so trajectories are not those of the native2d backend.
+
+Episodes: world ``i`` plays the task generator's episodes ``i, i + N, i + 2N, …`` of the current
+seed (``cfg.seed``, or the last ``reset(seed=…)``), each with the simulator stream
+``derive_rng(seed, "episode", index, "sim")`` as ``arena run`` uses. Results therefore depend on
+``(config, seed, N)`` only, and a world's first episode does not depend on ``N`` at all.
+
+Autoreset: gymnasium's ``NEXT_STEP`` mode (the default): the step that ends a world's episode
+returns its last observation with ``terminated``/``truncated`` set; on the next ``step()`` that
+world ignores its action, restarts, and returns the first observation of its next episode with
+reward 0 and both flags false. ``SAME_STEP`` (``autoreset_mode=AutoresetMode.SAME_STEP``):
+the ending step already returns the new episode's first observation, with the last one in
+``info["final_obs"]`` (an object array) and its info in ``info["final_info"]`` (used by
+:class:`SB3VecEnv`).
+
+Info (arrays over worlds, each key ``k`` with its mask ``_k``, gymnasium's vector layout):
+``episode`` index, ``time`` (s), ``steps``, ``goal_distance`` (m), ``goal_radius`` (m),
+``outcome`` (``success``/``collision``/``timeout`` or ``None``), and after a step
+``collision`` and ``reward_terms`` (``{term: (N,)}``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+from numpy.typing import NDArray
+
+from arena.core.rng import derive_rng
+from arena.core.types import Outcome
+from arena.learn.actions import ActionDecoder
+from arena.learn.driver import (
+    ConfigLike,
+    SubgoalTracker,
+    planning_grid,
+    resolve_config,
+    substeps,
+)
+from arena.learn.observations import Obs, ObservationBuilder, ObsInput
+from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput
+from arena.robots.model import RobotModel
+from arena.robots.presets import load_robot
+from arena.sim.batch import BatchSim, BatchState
+from arena.tasks.episode import Episode
+from arena.tasks.generator import TaskGenerator
+
+F64 = NDArray[np.float64]
+B1 = NDArray[np.bool_]
+
+_SUCCESS = Outcome.SUCCESS.value
+_COLLISION = Outcome.COLLISION.value
+_TIMEOUT = Outcome.TIMEOUT.value
+
+
+class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
+    """``num_envs`` single-robot worlds in one :class:`BatchSim`; see the module docstring.
+
+    Args:
+        config: an :class:`ExperimentConfig`, a YAML path or ``None`` (the packaged default).
+        overrides: ``key.path=value`` overrides (with a path or ``None`` only).
+        num_envs: ``N``, the number of worlds.
+        robot: a robot model replacing ``cfg.robot``.
+        sim_params: parameters of the batched simulator.
+        autoreset_mode: ``NEXT_STEP`` (default) or ``SAME_STEP``.
+    """
+
+    metadata = {  # noqa: RUF012  (gymnasium declares it an instance attribute)
+        "render_modes": [],
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+    }
+
+    def __init__(
+        self,
+        config: ConfigLike = None,
+        overrides: Sequence[str] = (),
+        *,
+        num_envs: int = 1,
+        robot: RobotModel | None = None,
+        sim_params: BatchSim.Params | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+    ) -> None:
+        if num_envs < 1:
+            raise ValueError(f"num_envs must be >= 1, got {num_envs}")
+        mode = AutoresetMode(autoreset_mode)
+        if mode == AutoresetMode.DISABLED:
+            raise ValueError("autoreset_mode must be NEXT_STEP or SAME_STEP")
+        self.autoreset_mode = mode
+        self.metadata = {**self.metadata, "autoreset_mode": mode}
+        self.cfg = resolve_config(config, overrides)
+        self.env_cfg = self.cfg.learning.env
+        self.robot = robot if robot is not None else load_robot(self.cfg.robot)
+        self.num_envs = n = int(num_envs)
+        self.dt = float(self.cfg.sim.dt)
+        self.substeps = substeps(self.env_cfg, self.dt)
+        self.period = self.dt * self.substeps
+        self.obs_builder = ObservationBuilder(self.env_cfg.observation, self.robot)
+        self.decoder = ActionDecoder(self.env_cfg.action, self.robot)
+        self.reward_fn = RewardFunction(self.env_cfg.reward)
+        self.single_observation_space = self.obs_builder.space
+        self.single_action_space = self.decoder.space
+        self.observation_space = batch_space(self.single_observation_space, n)
+        self.action_space = batch_space(self.single_action_space, n)
+        self.render_mode = None
+        self.sim = BatchSim(n, sim_params)
+        self.seed_value = int(self.cfg.seed)
+        self.generator = self._generator(self.seed_value)
+        self.radius = float(self.robot.radius)
+        # per world bookkeeping
+        stack = self.env_cfg.observation.laser_stack
+        self._k = np.zeros(n, dtype=np.int64)  # episodes started by each world
+        self._ep_index = np.zeros(n, dtype=np.int64)
+        self._goals = np.zeros((n, 2))
+        self._goal_radius = np.zeros(n)
+        self._time_limit = np.zeros(n)
+        self._steps = np.zeros(n, dtype=np.int64)
+        self._scans = np.zeros((n, stack, self.obs_builder.beams))
+        self._last_action = np.zeros((n, 3))
+        self._autoreset = np.zeros(n, dtype=bool)
+        self._outcome: NDArray[np.object_] = np.full(n, None, dtype=object)
+        self._state: BatchState | None = None
+        self._ones = np.ones(n, dtype=bool)
+        self._arange = np.arange(n)
+        self._safe = np.full(n, self.radius + self.env_cfg.safety_distance)
+        self._rrad = np.full(n, self.radius)
+        self._dt_arr = np.full(n, self.period)
+        self._max_steps = np.full(n, self.env_cfg.max_steps, dtype=np.int64)
+        self._zeros = np.zeros(n)
+        # subgoals (learning.env.observation.subgoal): one tracker per world, as SocialNavEnv
+        self._episodes: list[Episode | None] = [None] * n
+        sub = self.env_cfg.observation.subgoal
+        inscribed = self.radius + float(self.cfg.navigation.inflation_margin)
+        self.trackers: list[SubgoalTracker] | None = (
+            [SubgoalTracker(sub, inscribed, 1) for _ in range(n)] if sub.enabled else None
+        )
+        self._subgoals = np.zeros((n, 2))
+        self._stage: int | None = None
+
+    # -- episodes ----------------------------------------------------------------------------------
+    def _generator(self, seed: int) -> TaskGenerator:
+        cfg = self.cfg.model_copy(update={"seed": int(seed)})
+        gen: TaskGenerator = TaskGenerator.from_config(cfg, [self.robot])
+        stage = getattr(self, "_stage", None)
+        if stage is not None:
+            for m in _staged_modules(gen):
+                m.set_stage(stage)
+        return gen
+
+    def set_stage(self, index: int) -> int:
+        """Move every ``staged`` task module to ``index`` (clamped); return the stage."""
+        self._stage = int(index)
+        stages = [m.set_stage(index) for m in _staged_modules(self.generator)]
+        return stages[0] if stages else -1
+
+    def get_stage(self) -> int:
+        """The current curriculum stage (-1 without a ``staged`` module)."""
+        mods = _staged_modules(self.generator)
+        return int(mods[0].stage) if mods else -1
+
+    def _draw(self, worlds: Sequence[int]) -> tuple[list[Episode], list[np.random.Generator]]:
+        """The next episode (and simulator stream) of each world in ``worlds``."""
+        eps: list[Episode] = []
+        rngs: list[np.random.Generator] = []
+        for i in worlds:
+            idx = i + int(self._k[i]) * self.num_envs
+            self._k[i] += 1
+            ep = self.generator.episode(idx)
+            eps.append(ep)
+            rngs.append(derive_rng(self.seed_value, "episode", idx, "sim"))
+            self._ep_index[i] = idx
+            self._episodes[i] = ep
+            self._goals[i] = ep.robots[0].goal.as_array()[:2]
+            self._goal_radius[i] = ep.goal_radius
+            self._time_limit[i] = ep.time_limit
+        return eps, rngs
+
+    def _restart(self, worlds: NDArray[np.int64], state: BatchState) -> None:
+        """Bookkeeping of freshly reset worlds (state: the snapshot after their reset)."""
+        self._steps[worlds] = 0
+        self._last_action[worlds] = 0.0
+        self._scans[worlds] = state.scans[worlds][:, None, :]
+        self._outcome[worlds] = None
+        self._autoreset[worlds] = False
+        if self.trackers is not None:
+            for i in np.asarray(worlds).tolist():
+                ep = self._episodes[i]
+                assert ep is not None
+                tr = self.trackers[i]
+                tr.reset(planning_grid(ep), state.poses[i : i + 1], self._goals[i : i + 1], 0.0)
+                self._subgoals[i] = tr.current[0]
+
+    def _update_subgoals(self, state: BatchState, skip: B1 | None = None) -> None:
+        """Replan/move each world's subgoal after a step (worlds in ``skip`` restart anyway)."""
+        if self.trackers is None:
+            return
+        for i, tr in enumerate(self.trackers):
+            if skip is not None and skip[i]:
+                continue
+            tr.update(state.poses[i : i + 1], self._goals[i : i + 1], float(state.time[i]))
+            self._subgoals[i] = tr.current[0]
+
+    def reset(
+        self, *, seed: int | list[int] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[Any, dict[str, Any]]:
+        """Start every world's next episode; ``seed`` restarts at episodes ``0..N-1`` of it.
+
+        ``options={"reset_mask": (N,) bool}`` restarts only the masked worlds.
+        """
+        if isinstance(seed, list | tuple):
+            if len(set(seed)) != 1:
+                raise ValueError("BatchedSocialNavEnv takes one seed for all worlds")
+            seed = int(seed[0])
+        if seed is not None:
+            self._np_random, _ = _seeding(int(seed))
+            if int(seed) != self.seed_value:
+                self.seed_value = int(seed)
+                self.generator = self._generator(self.seed_value)
+            self._k[:] = 0
+        mask = (options or {}).get("reset_mask")
+        if mask is not None and self._state is not None and seed is None:
+            worlds = np.flatnonzero(np.asarray(mask, dtype=bool))
+            eps, rngs = self._draw(worlds.tolist())
+            state = self.sim.reset_worlds(worlds, eps, rngs)
+        else:
+            worlds = self._arange
+            eps, rngs = self._draw(worlds.tolist())
+            state = self.sim.reset(eps, rngs)
+        self._state = state
+        self._restart(worlds, state)
+        obs = self._observe(state)
+        return obs, self._info(state)
+
+    # -- stepping ----------------------------------------------------------------------------------
+    def step(self, actions: Any) -> tuple[Any, F64, B1, B1, dict[str, Any]]:
+        """Hold each world's action for one action period (autoreset as the mode says)."""
+        if self._state is None:
+            raise RuntimeError("call reset() before step()")
+        n = self.num_envs
+        cmd = self.decoder.decode(actions)
+        if cmd.shape[0] != n:
+            raise ValueError(f"expected {n} actions, got {cmd.shape[0]}")
+        restart = self._autoreset.copy()  # NEXT_STEP: finished last step, restart now
+        cmd[restart] = 0.0
+        prev = self._state
+        prev_pose = prev.poses
+        d = self._goals - prev_pose[:, :2]
+        prev_dist = np.hypot(d[:, 0], d[:, 1])
+        collision = np.zeros(n, dtype=bool)
+        state = prev
+        for _ in range(self.substeps):
+            state = self.sim.step(cmd, self.dt)
+            collision |= state.collided
+        self._steps += 1
+        scans = state.scans
+        if self._scans.shape[1] > 1:
+            self._scans[:, :-1] = self._scans[:, 1:]
+        self._scans[:, -1] = scans
+        d = self._goals - state.poses[:, :2]
+        dist = np.hypot(d[:, 0], d[:, 1])
+        goal_reached = dist < self._goal_radius
+        pd = state.ped_positions - state.poses[:, None, :2]
+        ped_d = np.hypot(pd[..., 0], pd[..., 1])
+        inp = RewardInput(
+            action=cmd,
+            prev_action=self._last_action.copy(),
+            goal_distance=dist,
+            prev_goal_distance=prev_dist,
+            goal_jump=self._zeros,
+            goal_radius=self._goal_radius.copy(),
+            goal_reached=goal_reached,
+            min_range=scans.min(axis=1) if scans.shape[1] else np.full(n, np.inf),
+            robot_radius=self._rrad,
+            safe_dist=self._safe,
+            collision=collision,
+            heading=state.poses[:, 2].copy(),
+            prev_heading=prev_pose[:, 2],
+            dt=self._dt_arr,
+            step=self._steps.copy(),
+            max_steps=self._max_steps,
+            ped_distance=ped_d,
+            ped_kind=state.ped_kinds,
+            ped_mask=state.ped_mask,
+        )
+        out = self.reward_fn(inp)
+        self._last_action = cmd
+        terminated, truncated, outcome = self._ends(out, goal_reached, collision, state)
+        reward = out.total.copy()
+        self._state = state
+        self._outcome = outcome
+        self._update_subgoals(state, restart)
+        if self.autoreset_mode == AutoresetMode.NEXT_STEP:
+            if restart.any():
+                worlds = np.flatnonzero(restart)
+                eps, rngs = self._draw(worlds.tolist())
+                state = self.sim.reset_worlds(worlds, eps, rngs)
+                self._state = state
+                self._restart(worlds, state)
+                reward[restart] = 0.0
+                terminated[restart] = False
+                truncated[restart] = False
+            obs = self._observe(state)
+            info = self._info(state, out, collision & ~restart)
+            self._autoreset = terminated | truncated
+            return obs, reward, terminated, truncated, info
+        # SAME_STEP
+        done = terminated | truncated
+        final_obs = self._observe(state) if done.any() else None
+        info = self._info(state, out, collision)
+        if final_obs is not None:
+            worlds = np.flatnonzero(done)
+            fo = np.full(n, None, dtype=object)
+            for i in worlds:
+                fo[i] = self._single(final_obs, int(i))
+            final_info = {
+                k: v for k, v in info.items()
+            }
+            info["final_info"] = final_info
+            info["_final_info"] = done.copy()
+            info["final_obs"] = fo
+            info["_final_obs"] = done.copy()
+            eps, rngs = self._draw(worlds.tolist())
+            state = self.sim.reset_worlds(worlds, eps, rngs)
+            self._state = state
+            self._restart(worlds, state)
+            fresh = self._info(state)
+            for k in ("episode_index", "time", "steps", "goal_distance", "goal_radius", "outcome"):
+                info[k] = fresh[k]
+        return self._observe(state), reward, terminated, truncated, info
+
+    def _ends(
+        self, out: RewardOutput, goal_reached: B1, collision: B1, state: BatchState
+    ) -> tuple[B1, B1, NDArray[np.object_]]:
+        """Termination, truncation and outcome per world (the rules of the single env)."""
+        term_reason = (out.reason == DoneReason.SUCCESS) | (out.reason == DoneReason.COLLISION)
+        terminated = goal_reached | collision | (out.done & term_reason)
+        limit = (self._steps >= self.env_cfg.max_steps) | (
+            state.time >= self._time_limit - 1e-9
+        )
+        truncated = ~terminated & (limit | (out.done & ~term_reason))
+        outcome: NDArray[np.object_] = np.full(self.num_envs, None, dtype=object)
+        outcome[truncated] = _TIMEOUT
+        outcome[terminated] = _SUCCESS
+        outcome[collision | (out.reason == DoneReason.COLLISION)] = _COLLISION
+        return terminated, truncated, outcome
+
+    # -- observations and info ---------------------------------------------------------------------
+    def _observe(self, state: BatchState) -> Any:
+        n = self.num_envs
+        m = state.ped_positions.shape[1]
+        goals = self._goals if self.trackers is None else self._subgoals
+        inp = ObsInput(
+            poses=state.poses, twists=state.twists, goals=goals, scans=self._scans,
+            last_action=self._last_action, ped_pos=state.ped_positions,
+            ped_vel=state.ped_velocities, ped_kind=state.ped_kinds,
+            ped_state=np.maximum(state.ped_states, 0), ped_mask=state.ped_mask,
+        )
+        if m == 0:
+            inp = ObsInput(
+                poses=inp.poses, twists=inp.twists, goals=inp.goals, scans=inp.scans,
+                last_action=inp.last_action, ped_pos=np.zeros((n, 0, 2)),
+                ped_vel=np.zeros((n, 0, 2)), ped_kind=np.zeros((n, 0), np.int64),
+                ped_state=np.zeros((n, 0), np.int64), ped_mask=np.zeros((n, 0), bool),
+            )
+        obs: Obs = self.obs_builder.build(inp)
+        if self.env_cfg.observation.flatten:
+            return self.obs_builder.flatten(obs)
+        return obs
+
+    def _single(self, obs: Any, i: int) -> Any:
+        if isinstance(obs, dict):
+            return {k: v[i].copy() for k, v in obs.items()}
+        return obs[i].copy()
+
+    def _info(
+        self, state: BatchState, out: RewardOutput | None = None, collision: B1 | None = None
+    ) -> dict[str, Any]:
+        d = self._goals - state.poses[:, :2]
+        ones = self._ones
+        info: dict[str, Any] = {
+            "episode_index": self._ep_index.copy(), "_episode_index": ones.copy(),
+            "time": state.time.copy(), "_time": ones.copy(),
+            "steps": self._steps.copy(), "_steps": ones.copy(),
+            "goal_distance": np.hypot(d[:, 0], d[:, 1]), "_goal_distance": ones.copy(),
+            "goal_radius": self._goal_radius.copy(), "_goal_radius": ones.copy(),
+            "outcome": self._outcome.copy(), "_outcome": ones.copy(),
+        }
+        if out is not None and collision is not None:
+            terms: dict[str, Any] = {}
+            for k, v in out.terms.items():
+                terms[k] = v
+                terms[f"_{k}"] = ones.copy()
+            info["reward_terms"] = terms
+            info["_reward_terms"] = ones.copy()
+            info["collision"] = collision.copy()
+            info["_collision"] = ones.copy()
+        return info
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Nothing to release (no subprocesses)."""
+
+
+def _staged_modules(gen: TaskGenerator) -> list[Any]:
+    from arena.tasks.modules.staged import Staged
+
+    return [m for m in gen.modules if isinstance(m, Staged)]
+
+
+def _seeding(seed: int) -> tuple[np.random.Generator, int]:
+    from gymnasium.utils import seeding
+
+    return seeding.np_random(seed)
+
+
+# ------------------------------------------------------------------------------------------------
+# Stable-Baselines3 adapter (only when stable-baselines3 is importable)
+# ------------------------------------------------------------------------------------------------
+try:
+    from stable_baselines3.common.vec_env.base_vec_env import VecEnv as _SB3VecEnv
+
+    HAVE_SB3 = True
+except ImportError:  # pragma: no cover - optional dependency
+    HAVE_SB3 = False
+
+
+if HAVE_SB3:
+
+    class SB3VecEnv(_SB3VecEnv):
+        """Stable-Baselines3 ``VecEnv`` over a :class:`BatchedSocialNavEnv` (``SAME_STEP``).
+
+        SB3 conventions: ``reset()`` returns observations only; ``step_wait()`` returns
+        ``(obs, rewards, dones, infos)`` with a list of per-world info dicts; a finished world is
+        reset in the same step, its last observation in ``infos[i]["terminal_observation"]``
+        and ``infos[i]["TimeLimit.truncated"]`` set on truncation. ``seed(s)`` applies at the
+        next ``reset()``.
+
+        Args:
+            config, overrides, num_envs, robot, sim_params: as :class:`BatchedSocialNavEnv`.
+        """
+
+        def __init__(
+            self,
+            config: ConfigLike = None,
+            overrides: Sequence[str] = (),
+            *,
+            num_envs: int = 1,
+            robot: RobotModel | None = None,
+            sim_params: BatchSim.Params | None = None,
+        ) -> None:
+            self.env = BatchedSocialNavEnv(
+                config, overrides, num_envs=num_envs, robot=robot, sim_params=sim_params,
+                autoreset_mode=AutoresetMode.SAME_STEP,
+            )
+            super().__init__(
+                num_envs, self.env.single_observation_space, self.env.single_action_space
+            )
+            self._actions: Any = None
+
+        def reset(self) -> Any:
+            """Restart every world (with the seed given to :meth:`seed`, if any)."""
+            seed = self._seeds[0] if self._seeds else None
+            obs, _ = self.env.reset(seed=seed)
+            self._reset_seeds()
+            self._reset_options()
+            return obs
+
+        def step_async(self, actions: np.ndarray) -> None:
+            """Remember the actions of the next :meth:`step_wait`."""
+            self._actions = actions
+
+        def step_wait(self) -> Any:
+            """One batched step; finished worlds restart at once (SB3 convention)."""
+            obs, rew, term, trunc, info = self.env.step(self._actions)
+            done = term | trunc
+            n = self.num_envs
+            infos: list[dict[str, Any]] = [{} for _ in range(n)]
+            src = info.get("final_info", info)
+            for i in range(n):
+                d = infos[i]
+                s = src if done[i] else info
+                for k in ("episode_index", "time", "steps", "goal_distance", "outcome",
+                          "collision"):
+                    if k in s:
+                        v = s[k][i]
+                        d[k] = v.item() if isinstance(v, np.generic) else v
+                d["is_success"] = d.get("outcome") == _SUCCESS
+                if done[i]:
+                    d["terminal_observation"] = info["final_obs"][i]
+                    d["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
+            return obs, rew.astype(np.float32), done, infos
+
+        def close(self) -> None:
+            """Close the batched env."""
+            self.env.close()
+
+        def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
+            """The batched env's attribute, once per requested world."""
+            return [getattr(self.env, attr_name) for _ in self._get_indices(indices)]
+
+        def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
+            """Set an attribute of the batched env (shared by every world)."""
+            setattr(self.env, attr_name, value)
+
+        def env_method(
+            self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
+        ) -> list[Any]:
+            """Call a method of the batched env, once per requested world."""
+            fn = getattr(self.env, method_name)
+            return [fn(*method_args, **method_kwargs) for _ in self._get_indices(indices)]
+
+        def env_is_wrapped(self, wrapper_class: Any, indices: Any = None) -> list[bool]:
+            """No world is wrapped."""
+            return [False for _ in self._get_indices(indices)]

@@ -1,0 +1,134 @@
+"""The ``learning.ppo`` and ``learning.train`` blocks: PPO hyper-parameters and the training run.
+
+Pydantic only (no torch), so that the experiment schema can import it. Defaults follow Arena's
+training config (arena_specs §8.5; the June 2024 values where March and June differ)::
+
+    learning:
+      ppo:
+        batch_size: 20480        # total rollout per update; n_steps per env = batch_size / n_envs
+        minibatch_size: 512      # SB3 batch_size (Arena: m_batch_size)
+        n_epochs: 3
+        learning_rate: 3.0e-4    # used when lr_schedule.enabled is false
+        lr_schedule: {enabled: true, initial: 1.0e-3, final: 1.0e-4}   # linear over the run
+        gamma: 0.99
+        gae_lambda: 0.95
+        clip_range: 0.25
+        ent_coef: 0.005
+        vf_coef: 0.22
+        max_grad_norm: 0.5
+        net_arch: {pi: [64, 64], vf: [64, 64]}
+        activation: relu
+        normalize: {norm_obs: true, norm_reward: false, clip_obs: 30.0, clip_reward: 20.0}
+      train:
+        total_steps: 4000000
+        n_envs: 4
+        vec_env: subproc
+        checkpoint_every: 100000
+        eval: {episodes: 40, every: 20000}
+        curriculum: {enabled: true, stop_success: 0.98}
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(frozen=True, extra="forbid")
+
+
+class LRSchedule(_Strict):
+    """Linear learning-rate schedule over the whole run (Arena's ``lr_schedule``)."""
+
+    enabled: bool = Field(True, description="linear initial → final; false: learning_rate")
+    initial: float = Field(1e-3, gt=0, description="learning rate at step 0")
+    final: float = Field(1e-4, gt=0, description="learning rate at total_steps")
+
+
+class NetArch(_Strict):
+    """Hidden layers of the policy (``pi``) and value (``vf``) MLPs after the feature extractor."""
+
+    pi: list[int] = Field([64, 64], description="policy MLP widths")
+    vf: list[int] = Field([64, 64], description="value MLP widths")
+
+    @model_validator(mode="after")
+    def _positive(self) -> NetArch:
+        if any(w < 1 for w in (*self.pi, *self.vf)):
+            raise ValueError("layer widths must be >= 1")
+        return self
+
+
+class NormalizeConfig(_Strict):
+    """SB3 ``VecNormalize`` (arena_specs §8.2: obs normalised, rewards not, clip 30)."""
+
+    norm_obs: bool = Field(True, description="running mean/var normalisation of observations")
+    norm_reward: bool = Field(False, description="normalise rewards by the return's std")
+    clip_obs: float = Field(30.0, gt=0, description="clip normalised observations to ±this")
+    clip_reward: float = Field(20.0, gt=0, description="clip normalised rewards to ±this")
+
+
+class PPOConfig(_Strict):
+    """Stable-Baselines3 PPO (arena_specs §8.5, Arena's ``rl_agent.ppo``)."""
+
+    batch_size: int = Field(
+        20480, ge=1, description="env steps per update over all envs (n_steps = this / n_envs)"
+    )
+    minibatch_size: int = Field(512, ge=1, description="SB3 minibatch (Arena: m_batch_size)")
+    n_epochs: int = Field(3, ge=1, description="passes over each rollout")
+    learning_rate: float = Field(3e-4, gt=0, description="constant rate without lr_schedule")
+    lr_schedule: LRSchedule = Field(default_factory=LRSchedule)
+    gamma: float = Field(0.99, gt=0, le=1, description="discount")
+    gae_lambda: float = Field(0.95, ge=0, le=1, description="GAE λ")
+    clip_range: float = Field(0.25, gt=0, description="PPO ratio clip")
+    ent_coef: float = Field(0.005, ge=0, description="entropy bonus weight")
+    vf_coef: float = Field(0.22, ge=0, description="value loss weight")
+    max_grad_norm: float = Field(0.5, gt=0, description="gradient clipping")
+    net_arch: NetArch = Field(default_factory=NetArch)
+    activation: Literal["relu", "tanh"] = Field("relu", description="hidden-layer activation")
+    normalize: NormalizeConfig = Field(default_factory=NormalizeConfig)
+
+
+class EvalConfig(_Strict):
+    """Periodic evaluation (deterministic policy, separate env) driving the curriculum."""
+
+    episodes: int = Field(40, ge=1, description="episodes per evaluation (Arena: 40-50)")
+    every: int = Field(20000, ge=1, description="env steps (all envs together) between evals")
+    seed_offset: int = Field(
+        10000, ge=0, description="the eval env's seed is the run's seed + this"
+    )
+
+
+class CurriculumTrainConfig(_Strict):
+    """Stage changes of ``task.modules`` ``staged`` from the evaluation success rate."""
+
+    enabled: bool = Field(True, description="only acts when the task has a staged module")
+    stop_success: float | None = Field(
+        0.98, ge=0, le=1, description="stop training at the last stage at this success; null: never"
+    )
+
+
+class TrainConfig(_Strict):
+    """One training run: length, parallel envs, checkpoints, evaluation, curriculum."""
+
+    total_steps: int = Field(4_000_000, ge=1, description="env steps (Arena Jun 2024: 4e6)")
+    n_envs: int = Field(4, ge=1, description="parallel training envs (Arena Jun 2024: 4)")
+    vec_env: Literal["dummy", "subproc", "batched"] = Field(
+        "subproc",
+        description="SB3 vector env; one env always runs in-process; batched: "
+        "BatchedSocialNavEnv (all envs in one BatchSim; evaluation stays on SocialNavEnv)",
+    )
+    seed: int | None = Field(None, ge=0, description="run seed; null: the experiment's seed")
+    checkpoint_every: int = Field(100_000, ge=1, description="env steps between checkpoints")
+    tensorboard: bool = Field(True, description="write TensorBoard logs to RUN/tb")
+    device: Literal["auto", "cpu", "cuda"] = Field("cpu", description="torch device")
+    eval: EvalConfig = Field(default_factory=EvalConfig)
+    curriculum: CurriculumTrainConfig = Field(default_factory=CurriculumTrainConfig)
+
+
+class TrainSettings(_Strict):
+    """``learning.ppo`` + ``learning.train`` together (what a run folder records)."""
+
+    ppo: PPOConfig = Field(default_factory=PPOConfig)
+    train: TrainConfig = Field(default_factory=TrainConfig)

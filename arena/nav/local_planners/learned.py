@@ -1,0 +1,221 @@
+"""``rosnav_rl``: a PPO policy trained with ``arena train``, as a local planner.
+
+Description:
+    Each tick the planner rebuilds the observation :class:`~arena.learn.env.SocialNavEnv`
+    gives its policy, from the :class:`LocalObservation`: ``lidar`` (the last
+    ``laser_stack`` scans; no-return beams read as the laser's maximum range), ``goal``
+    (``[ρ, θ]`` to a subgoal on the global path ``subgoal_horizon`` m ahead, Arena's
+    "spacial horizon", or to the goal when it is closer) and ``last_action`` (the planner's own
+    previous command). It runs the exported actor with numpy (:class:`NumpyPolicy`), decodes
+    the deterministic action into ``[vx, vy, ω]`` as the env does, and passes it through
+    :func:`~.path_tracking.finish_command` (acceleration window, velocity box).
+
+    Any laser works: each scan is resampled onto the policy's own beams
+    (:func:`resample_scan`, the layout recorded in the policy file's ``laser`` meta; files
+    without it are taken to have evenly spread full-circle beams).
+
+    Policies whose observation has ``pedestrians`` or ``semantic`` parts are not supported
+    yet (the local observation carries no pedestrian types or social states).
+
+Arguments:
+    See :class:`LearnedPlanner.Params`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import ClassVar, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+from pydantic import BaseModel, ConfigDict, Field
+
+from arena.core.errors import ConfigError
+from arena.learn.observations import subgoal_on_path
+from arena.learn.policy import NumpyPolicy
+from arena.nav.local_planners.base import LOCAL_PLANNERS, LocalObservation
+from arena.nav.local_planners.path_tracking import finish_command
+
+DEFAULT_WEIGHTS = (
+    Path(__file__).resolve().parents[2] / "learn" / "data" / "policies" / "rosnav_rl.npz"
+)
+"""The packaged policy (``arena/learn/data/policies/rosnav_rl.npz``)."""
+SUPPORTED_KEYS = frozenset({"lidar", "goal", "last_action"})
+
+
+def _wrap(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def beam_bins(angles: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Half-widths ``(below, above)`` (rad) of each beam's angular bin.
+
+    A bin reaches half way to each neighbour; a layout covering the full circle wraps around,
+    otherwise the end beams mirror their inner half-width.
+    """
+    a = np.asarray(angles, dtype=np.float64).reshape(-1)
+    n = a.size
+    if n == 0:
+        return np.zeros(0), np.zeros(0)
+    if n == 1:
+        return np.full(1, np.pi), np.full(1, np.pi)
+    gaps = np.abs(_wrap(np.diff(a)))  # (n-1,) spacing to the next beam
+    span = float(np.sum(gaps))
+    full = span + float(np.median(gaps)) >= 2 * np.pi - 1e-3
+    if full:
+        last = float(np.abs(_wrap(np.array([a[0] - a[-1]])))[0])
+        ring = np.append(gaps, last)
+        below = np.roll(ring, 1) / 2
+        above = ring / 2
+    else:
+        below = np.concatenate([[gaps[0]], gaps]) / 2
+        above = np.concatenate([gaps, [gaps[-1]]]) / 2
+    return below, above
+
+
+def resample_scan(
+    scan_angles: NDArray[np.float64],
+    scan_ranges: NDArray[np.float64],
+    beam_angles: NDArray[np.float64],
+    range_max: float,
+) -> NDArray[np.float64]:
+    """A scan (any beam count, incl. 0) as seen by the beams ``beam_angles`` (robot frame).
+
+    Per target beam: the minimum range of the scan beams inside its bin (:func:`beam_bins`),
+    else the range of the nearest scan beam by angle when it lies within one target spacing,
+    else ``range_max``; non-finite ranges read ``range_max``; clipped to ``[0, range_max]``.
+    Identical layouts give the scan back unchanged.
+    """
+    tgt = np.asarray(beam_angles, dtype=np.float64).reshape(-1)
+    sa = np.asarray(scan_angles, dtype=np.float64).reshape(-1)
+    sr = np.asarray(scan_ranges, dtype=np.float64).reshape(-1)
+    out = np.full(tgt.size, float(range_max))
+    if sa.size == 0 or tgt.size == 0:
+        return out
+    sr = np.clip(np.where(np.isfinite(sr), sr, range_max), 0.0, range_max)
+    below, above = beam_bins(tgt)
+    d = _wrap(sa[None, :] - tgt[:, None])  # (P, S)
+    inside = (d >= -below[:, None]) & (d < above[:, None])
+    binned = np.where(inside, sr[None, :], np.inf).min(axis=1)
+    has = inside.any(axis=1)
+    ad = np.abs(d)
+    nearest = np.argmin(ad, axis=1)
+    close = ad[np.arange(tgt.size), nearest] <= below + above
+    out = np.where(has, binned, np.where(close, sr[nearest], range_max))
+    return np.clip(out, 0.0, range_max)
+
+
+@LOCAL_PLANNERS.register("rosnav_rl", tags=("learned",))
+class LearnedPlanner:
+    """A trained PPO actor (numpy inference) driving the robot."""
+
+    supports: ClassVar[frozenset[str]] = frozenset({"diff_drive", "omni", "legged"})
+
+    class Params(BaseModel):
+        """Parameters of ``rosnav_rl``."""
+
+        model_config = ConfigDict(frozen=True, extra="forbid")
+        weights: str | None = Field(
+            None, description="exported policy (.npz, RUN/policy.npz); None: the packaged one"
+        )
+        subgoal_horizon: float | Literal["policy"] | None = Field(
+            "policy",
+            description="m along the path to the subgoal (Arena: 5.0); None: goal; policy: "
+            "the horizon the policy was trained with (observation.subgoal), else 5.0",
+        )
+
+    def __init__(self, params: Params | None = None) -> None:
+        self.params = p = params or self.Params()
+        path = Path(p.weights) if p.weights is not None else DEFAULT_WEIGHTS
+        if not path.is_file():
+            raise ConfigError(
+                f"no policy file {str(path)!r}: train one with `arena train CONFIG -o RUN` and "
+                "pass weights: RUN/policy.npz",
+                path="navigation.local_planner.weights",
+            )
+        self.policy = NumpyPolicy.load(path)
+        if not self.policy.is_dict:
+            raise ConfigError(
+                f"{path}: rosnav_rl needs a Dict-observation policy (observation.flatten: false)",
+                path="navigation.local_planner.weights",
+            )
+        extra = set(self.policy.keys) - SUPPORTED_KEYS
+        if extra:
+            raise ConfigError(
+                f"{path}: observation parts {sorted(extra)} are not supported by rosnav_rl "
+                f"(supported: {sorted(SUPPORTED_KEYS)})",
+                path="navigation.local_planner.weights",
+            )
+        if self.policy.meta.get("command") is None:
+            raise ConfigError(f"{path}: the policy file records no action decoding",
+                              path="navigation.local_planner.weights")
+        self.beam_angles = np.zeros(0)
+        self.range_max = 0.0
+        if "lidar" in self.policy.keys:
+            beams = int(self.policy.shapes["lidar"][1])
+            laser = self.policy.meta.get("laser") or {}
+            self.range_max = float(
+                laser.get("range_max", np.max(self.policy.arrays["high/lidar"]))
+            )
+            angles = laser.get("angles")
+            if angles is None:  # older files: evenly spread full-circle beams
+                angles = -np.pi + 2 * np.pi / beams * np.arange(beams)
+            self.beam_angles = np.asarray(angles, dtype=np.float64).reshape(-1)
+            if self.beam_angles.size != beams:
+                raise ConfigError(
+                    f"{path}: the laser meta has {self.beam_angles.size} angles for "
+                    f"{beams} lidar beams",
+                    path="navigation.local_planner.weights",
+                )
+        self.horizon: float | None
+        if p.subgoal_horizon == "policy":
+            sub = (self.policy.meta.get("observation") or {}).get("subgoal") or {}
+            self.horizon = float(sub["horizon"]) if sub.get("enabled") else 5.0
+        else:
+            self.horizon = p.subgoal_horizon
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget the scan history and the last command."""
+        self._scans: NDArray[np.float64] | None = None
+        self._last = np.zeros(3)
+
+    def observation(self, obs: LocalObservation) -> dict[str, NDArray[np.float32]]:
+        """The policy's observation for ``obs`` (updates the scan history)."""
+        pol = self.policy
+        out: dict[str, NDArray[np.float32]] = {}
+        if "lidar" in pol.keys:
+            stack = pol.shapes["lidar"][0]
+            r = resample_scan(obs.scan_angles, obs.scan_ranges, self.beam_angles, self.range_max)
+            if self._scans is None:
+                self._scans = np.repeat(r[None], stack, axis=0)
+            else:
+                self._scans = np.concatenate([self._scans[1:], r[None]], axis=0)
+            out["lidar"] = self._scans.astype(np.float32)
+        pose = np.asarray(obs.pose, dtype=np.float64).reshape(3)
+        if "goal" in pol.keys:
+            goal = np.array([obs.goal_pose.x, obs.goal_pose.y])
+            target = goal
+            path = np.asarray(obs.path, dtype=np.float64).reshape(-1, 2)
+            if self.horizon is not None and len(path):
+                target = subgoal_on_path(path, pose[:2], self.horizon)
+            d = target - pose[:2]
+            theta = (np.arctan2(d[1], d[0]) - pose[2] + np.pi) % (2 * np.pi) - np.pi
+            rho = min(float(np.hypot(d[0], d[1])), float(pol.arrays["high/goal"][0]))
+            out["goal"] = np.array([rho, theta], np.float32)
+        if "last_action" in pol.keys:
+            out["last_action"] = np.clip(
+                self._last, pol.arrays["low/last_action"], pol.arrays["high/last_action"]
+            ).astype(np.float32)
+        return out
+
+    def compute(self, obs: LocalObservation) -> NDArray[np.float64]:
+        """The policy's command, limited by :func:`finish_command`."""
+        action = self.policy.act(self.observation(obs))
+        cmd = self.policy.command(action)
+        lim = obs.limits
+        car = obs.drive == "ackermann" or lim.min_turning_radius > 0
+        twist = np.asarray(obs.twist, dtype=np.float64).reshape(3)
+        out = finish_command(cmd, twist, lim, float(obs.dt), car)
+        self._last = out.copy()
+        return out

@@ -1,0 +1,149 @@
+"""arena.learn.train: PPO smoke run, checkpoints, resume, curriculum logic, CLI errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+pytest.importorskip("torch")
+pytest.importorskip("stable_baselines3")
+pytest.importorskip("tensorboard")
+
+from arena.core.errors import ArenaError, ConfigError
+from arena.learn.train import (
+    CurriculumController,
+    LinearSchedule,
+    load_training,
+    read_run,
+    train,
+)
+from arena.learn.train_config import TrainSettings
+from arena.tasks.modules.staged import Staged
+from tests.learn.helpers import small_cfg, small_robot
+
+TINY = {
+    "ppo": {"batch_size": 32, "minibatch_size": 16, "n_epochs": 1,
+            "net_arch": {"pi": [16], "vf": [16]}},
+    "train": {"total_steps": 64, "n_envs": 2, "vec_env": "dummy", "checkpoint_every": 32,
+              "eval": {"episodes": 1, "every": 32}},
+}
+
+
+def _settings(**train):
+    data = json.loads(json.dumps(TINY))
+    data["train"].update(train)
+    return TrainSettings.model_validate(data)
+
+
+def test_smoke_run_checkpoint_tensorboard_and_resume(tmp_path):
+    cfg = small_cfg("task.obstacles={type: random, static: 0, dynamic: 1}")
+    run = tmp_path / "run"
+    res = train(cfg, _settings(), run, robot=small_robot(8))
+    assert res.steps == 64
+    man = read_run(run)
+    assert man["steps_done"] == 64 and man["seed"] == cfg.seed
+    assert (run / man["checkpoint"] / "model.zip").is_file()
+    assert (run / man["checkpoint"] / "vecnormalize.pkl").is_file()
+    assert (run / "checkpoints" / "step_32" / "model.zip").is_file()
+    assert list((run / "tb").rglob("events.out.tfevents.*"))
+    assert (run / "policy.npz").is_file()
+    with pytest.raises(ArenaError, match="already holds a run"):
+        train(cfg, _settings(), run, robot=small_robot(8))
+    bad = TrainSettings.model_validate({**TINY, "ppo": {**TINY["ppo"], "n_epochs": 2}})
+    with pytest.raises(ArenaError, match=r"cannot resume: settings key 'ppo\.n_epochs'"):
+        train(cfg, bad, run, resume=True, robot=small_robot(8))
+    res2 = train(cfg, _settings(total_steps=128), run, resume=True, robot=small_robot(8))
+    assert res2.steps == 128
+    assert read_run(run)["steps_done"] == 128
+    assert (run / "checkpoints" / "step_128" / "model.zip").is_file()
+
+
+def test_curriculum_run_applies_stage(tmp_path):
+    cfg = small_cfg("task.modules=[{type: staged, curriculum: default}]")
+    # the default curriculum's stages switch to barn maps: keep them (fast) and only check the
+    # stage bookkeeping, with a stub evaluator that always succeeds
+    seen = []
+    res = train(cfg, _settings(total_steps=64), tmp_path / "run", robot=small_robot(8),
+                evaluate=lambda: 1.0, on_eval=seen.append)
+    assert [s.stage for s in seen] == [1, 2]
+    assert res.stage == 2 and read_run(tmp_path / "run")["stage"] == 2
+
+
+class _Stub:
+    def __init__(self, rates):
+        self.rates = list(rates)
+
+    def __call__(self):
+        return self.rates.pop(0)
+
+
+def test_curriculum_controller_promotes_demotes_and_stops():
+    staged = Staged(Staged.Params(curriculum="default"))
+    n = staged.num_stages
+    applied = []
+    ctl = CurriculumController(
+        staged, _Stub([0.9, 0.95, 0.7, 0.65, 0.1, 0.3]), applied.append, stop_success=0.98
+    )
+    states = [ctl.step() for _ in range(6)]
+    assert [s.change for s in states] == [1, 1, 0, -1, -1, 0]
+    assert [s.stage for s in states] == [1, 2, 2, 1, 0, 0]
+    assert applied == [1, 2, 1, 0]
+    assert not any(s.stop for s in states)
+    staged.set_stage(n - 1)
+    ctl.evaluate = _Stub([0.97, 0.98])
+    assert not ctl.step().stop
+    assert ctl.step().stop
+
+
+def test_linear_schedule():
+    s = LinearSchedule(1e-3, 1e-4)
+    assert s(1.0) == pytest.approx(1e-3) and s(0.0) == pytest.approx(1e-4)
+
+
+def test_load_training_reads_blocks(tmp_path):
+    f = tmp_path / "exp.yaml"
+    f.write_text("seed: 3\nlearning:\n  env: {max_steps: 30}\n  ppo: {n_epochs: 5}\n")
+    cfg, s = load_training(f, ["learning.train.n_envs=2", "learning.ppo.gamma=0.9"])
+    assert cfg.seed == 3 and cfg.learning.env.max_steps == 30
+    assert s.ppo.n_epochs == 5 and s.ppo.gamma == 0.9 and s.train.n_envs == 2
+    with pytest.raises(ConfigError, match=r"learning\.ppo\.bogus"):
+        load_training(f, ["learning.ppo.bogus=1"])
+    with pytest.raises(ConfigError, match="not a multiple of n_envs"):
+        train(cfg, TrainSettings.model_validate({"ppo": {"batch_size": 33, "minibatch_size": 8},
+                                                 "train": {"n_envs": 2}}), tmp_path / "r")
+
+
+def test_cli_bad_config_is_one_line(tmp_path):
+    f = tmp_path / "exp.yaml"
+    f.write_text("learning:\n  ppo: {clip_range: -1}\n")
+    res = subprocess.run(
+        [sys.executable, "-m", "arena.cli", "train", str(f), "-o", str(tmp_path / "r")],
+        capture_output=True, text=True, check=False,
+    )
+    assert res.returncode == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "learning.ppo.clip_range" in lines[0], res.stderr
+
+
+def test_batched_vec_env_run_with_real_evaluator(tmp_path):
+    from arena.learn.batched import SB3VecEnv
+    from arena.learn.policy import NumpyPolicy
+    from arena.learn.train import make_vec_env
+
+    cfg = small_cfg("task.modules=[{type: staged, curriculum: default}]",
+                    "learning.env.observation.subgoal.enabled=true")
+    venv = make_vec_env(cfg, 4, "batched", small_robot(8), seed=11)
+    assert isinstance(venv, SB3VecEnv) and venv.num_envs == 4
+    assert venv.env_method("set_stage", 1) == [1] * 4 and venv.env.get_stage() == 1
+    venv.close()
+    seen = []
+    res = train(cfg, _settings(total_steps=64, n_envs=4, vec_env="batched"), tmp_path / "run",
+                robot=small_robot(8), on_eval=seen.append)  # evaluation: SocialNavEnv
+    assert res.steps == 64 and seen and 0.0 <= seen[0].success_rate <= 1.0
+    man = read_run(tmp_path / "run")
+    assert man["steps_done"] == 64 and man["settings"]["train"]["vec_env"] == "batched"
+    pol = NumpyPolicy.load(res.policy)
+    assert len(pol.meta["laser"]["angles"]) == 8
