@@ -25,7 +25,8 @@ from arena.crowd.base import CROWD_MODELS, CrowdFrame, CrowdModel, RobotView
 from arena.crowd.integrator import integrate
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState, StartupMode
-from arena.crowd.walls import WallIndex, world_segments
+from arena.crowd.walls import WallIndex, grid_wall_segments
+from arena.maps.grid import OccupancyGrid
 from arena.maps.raster import polygon_mask
 from arena.sim.state import AgentStates, RobotStates, StaticWorld
 from arena.tasks.episode import WAYPOINT_RANDOM, AgentSpawn
@@ -109,7 +110,7 @@ class CrowdSimulator:
 
             state.group = form_groups(state.positions, cfg, rng)
             state.leader = leaders_of(state.group)
-        self._walls_a, self._walls_b = world_segments(world)
+        self._walls_a, self._walls_b = episode_segments(world)
         self._wall_index = WallIndex(self._walls_a, self._walls_b)
         # Distance from each cell to the nearest wall, obstacle or map edge, for the wall
         # guard's fast path (agents far from everything skip the exact segment test).
@@ -259,6 +260,40 @@ class CrowdSimulator:
             kinds=s.kinds.copy(),
             states=s.social_state.copy(),
         )
+
+
+_GRID_WALLS: list[tuple[NDArray[np.bool_], tuple[float, ...], float, FloatArray, FloatArray]] = []
+"""The last map's wall segments (at most one entry): see :func:`grid_walls`."""
+
+
+def grid_walls(grid: OccupancyGrid) -> tuple[FloatArray, FloatArray]:
+    """:func:`~arena.crowd.walls.grid_wall_segments` of ``grid`` (``border=True``), cached.
+
+    Tracing the walls costs milliseconds and every episode reset asks for them several times
+    (simulator, crowd model, social states) on a map that rarely changes. The single-entry
+    cache compares the occupancy (a copy, so in-place edits are seen), origin and resolution;
+    the arrays it returns are read-only and the same objects while the map stays the same.
+    """
+    occ = np.asarray(grid.occupied)
+    origin = tuple(float(v) for v in grid.origin)
+    res = float(grid.resolution)
+    if _GRID_WALLS:
+        c_occ, c_origin, c_res, a, b = _GRID_WALLS[0]
+        if c_origin == origin and c_res == res and c_occ.shape == occ.shape and np.array_equal(
+            c_occ, occ
+        ):
+            return a, b
+    a, b = grid_wall_segments(grid)
+    a.flags.writeable = False
+    b.flags.writeable = False
+    _GRID_WALLS[:] = [(occ.copy(), origin, res, a, b)]
+    return a, b
+
+
+def episode_segments(world: StaticWorld) -> tuple[FloatArray, FloatArray]:
+    """:func:`~arena.crowd.walls.world_segments` of ``world``, the map's part cached."""
+    ga, gb = grid_walls(world.grid)
+    return np.concatenate([ga, world.segments_a]), np.concatenate([gb, world.segments_b])
 
 
 def robot_view(robots: RobotStates) -> RobotView:

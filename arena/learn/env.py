@@ -34,11 +34,13 @@ Crowd:
     on and an RL episode equals the ``arena run`` episode of the same seed and index. The
     crowd is most of a step's cost. Measured on one shared core (small_office, jackal with 720
     beams, 20 people, 2026-11, CPU time per env step, resets excluded): pysocial + social
-    states ≈ 1,100 steps/s; pysocial without states ≈ 1,550; pedsim or orca + states ≈ 1,300;
-    ``waypoint_walker`` without states ≈ 2,700. For throughput-bound experiments pass e.g.
+    states ≈ 1,300 steps/s (≈ 1,100 before the statechart kernels); pysocial without states
+    ≈ 1,550; pedsim or orca + states ≈ 1,300; ``waypoint_walker`` without states ≈ 2,700. For
+    throughput-bound experiments pass e.g.
     ``overrides=["crowd={type: waypoint_walker}", "pedestrians.social_states=false"]``
-    (scripted walkers: no reaction to the robot). An episode reset (task generation, mostly
-    pedestrian placement) costs ≈ 60 ms.
+    (scripted walkers: no reaction to the robot), or train on
+    :class:`~arena.learn.batched.BatchedSocialNavEnv`. An episode reset (task generation,
+    mostly the distance transforms) costs ≈ 30 ms.
 
 Starting State:
     The episode's start pose, at rest; people at their spawn positions.

@@ -552,6 +552,11 @@ class RewardFunction:
             self.terms[name] = cls(params) if params is not None else cls()
             self.weights[name] = float(meta["weight"])
             self.on_violation[name] = bool(meta["on_safe_dist_violation"])
+        # (name, term, weight, on_violation) in file order: one tuple per term for __call__
+        self._plan = [
+            (name, term, self.weights[name], self.on_violation[name])
+            for name, term in self.terms.items()
+        ]
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -559,19 +564,36 @@ class RewardFunction:
         return tuple(self.terms)
 
     def __call__(self, inp: RewardInput) -> RewardOutput:
-        """Evaluate every term for ``N`` worlds."""
-        total = np.zeros(inp.n)
-        done = np.zeros(inp.n, dtype=bool)
-        reason = np.zeros(inp.n, dtype=np.int64)
-        breached = inp.safe_dist_breached
+        """Evaluate every term for ``N`` worlds.
+
+        Per term: ``share = where(active, weight · reward, 0)`` with ``active`` all true for
+        terms evaluated during a safe-distance breach, else ``~breached``; ``done`` and the
+        largest ``reason`` come from the active worlds. The shortcuts below (no multiplication
+        by a weight of 1, no masking of always-active terms, no reason update when nothing
+        fired) skip only operations that would leave every value unchanged, so the output is
+        bit-identical to the plain formula; they matter because a single env calls this with
+        ``N = 1`` every step, where each numpy call costs more than its arithmetic.
+        """
+        n = inp.n
+        total = np.zeros(n)
+        done = np.zeros(n, dtype=bool)
+        reason = np.zeros(n, dtype=np.int64)
+        calm: BoolArray | None = None  # ~breached, computed once and only when a term needs it
         parts: dict[str, FloatArray] = {}
-        for name, term in self.terms.items():
+        for name, term, weight, on_violation in self._plan:
             res = term(inp)
-            active = np.ones(inp.n, dtype=bool) if self.on_violation[name] else ~breached
-            r = np.where(active, self.weights[name] * res.reward, 0.0)
+            # A fresh array per term: the shares are returned and must not alias the term's
+            # (or the input's) arrays.
+            r = res.reward * weight if weight != 1.0 else np.array(res.reward, dtype=np.float64)
+            fired = res.done
+            if not on_violation:
+                if calm is None:
+                    calm = ~inp.safe_dist_breached
+                r = np.where(calm, r, 0.0)
+                fired = fired & calm
             parts[name] = r
             total += r
-            fired = res.done & active
-            done |= fired
-            reason = np.where(fired, np.maximum(reason, int(res.reason)), reason)
+            if fired.any():
+                done |= fired
+                reason = np.where(fired, np.maximum(reason, int(res.reason)), reason)
         return RewardOutput(total, parts, done, reason)

@@ -98,9 +98,7 @@ class WorldSampler:
         zone = ForbiddenDisc(float(xy[0]), float(xy[1]), float(radius))
         self._forbidden_discs.append(zone)
         if self._blocked_cache is not None:
-            self._blocked_cache |= disk_mask(
-                self.grid, np.array([[zone.x, zone.y]]), np.array([zone.radius])
-            )
+            _or_disk(self._blocked_cache, self.grid, zone.x, zone.y, zone.radius)
 
     def forbid_polygon(self, polygon: FloatArray) -> None:
         """Add a forbidden polygon (m)."""
@@ -342,3 +340,22 @@ class WorldSampler:
         inside = points_in_polygon(g.cell_to_world(cells), poly)
         mask[cells[inside, 0], cells[inside, 1]] = True
         return mask
+
+
+def _or_disk(mask: NDArray[np.bool_], grid: OccupancyGrid, x: float, y: float, r: float) -> None:
+    """``mask |= disk_mask(grid, [[x, y]], [r])``, touching only the disc's window.
+
+    The same window and cell test as :func:`~arena.maps.raster.disk_mask`; a reset forbids a
+    few dozen discs, and a full-map mask per disc cost most of their time.
+    """
+    res = grid.resolution
+    k = math.ceil(r / res) + 1
+    row, col = grid.world_to_cell([x, y])
+    r0, r1 = max(row - k, 0), min(row + k + 1, grid.height)
+    c0, c1 = max(col - k, 0), min(col + k + 1, grid.width)
+    if r0 >= r1 or c0 >= c1:
+        return
+    rows, cols = np.mgrid[r0:r1, c0:c1]
+    cx = grid.origin[0] + (cols + 0.5) * res
+    cy = grid.origin[1] + (rows + 0.5) * res
+    mask[r0:r1, c0:c1] |= (cx - x) ** 2 + (cy - y) ** 2 <= r * r

@@ -222,3 +222,24 @@ def test_compiled_integrator_matches_guard_reference():
     # Nobody changed side of the middle wall.
     assert np.array_equal(new_p[:, 0] < 5.0, p0[:, 0] < 5.0)
     assert np.all(np.hypot(*new_v.T) <= vmax * (1 + 1e-9) + 1e-9)
+
+
+def test_grid_walls_are_cached_per_map():
+    """Same map: the same read-only arrays; another occupancy: traced again."""
+    from arena.crowd.simulator import episode_segments, grid_walls
+    from arena.crowd.walls import world_segments
+
+    occ = np.zeros((30, 40), dtype=bool)
+    occ[10:20, 5:8] = True
+    grid = OccupancyGrid.from_occupied(occ, 0.1)
+    a, b = grid_walls(grid)
+    ra, rb = grid_wall_segments(grid)
+    assert np.array_equal(a, ra) and np.array_equal(b, rb)
+    assert not a.flags.writeable
+    assert grid_walls(OccupancyGrid.from_occupied(occ.copy(), 0.1))[0] is a  # equal map
+    occ[0:3, 0:3] = True
+    a2, _ = grid_walls(OccupancyGrid.from_occupied(occ, 0.1))
+    assert a2 is not a and not np.array_equal(a2, a)
+    world = StaticWorld.build(OccupancyGrid.from_occupied(occ, 0.1))
+    for got, want in zip(episode_segments(world), world_segments(world), strict=True):
+        assert got.tobytes() == want.tobytes()

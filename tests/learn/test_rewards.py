@@ -206,3 +206,42 @@ def test_reward_term_conformance(name):
         ped_mask=np.zeros((n, 0), bool),
     )
     assert np.all(np.isfinite(t(empty).reward))
+
+
+def test_function_shortcuts_match_the_plain_formula():
+    """Weights, masking and reasons as ``where(active, w · r, 0)``; shares are fresh arrays."""
+    spec = {
+        "goal_reached": {"reward": 15, "weight": 0.5, "_on_safe_dist_violation": False},
+        "collision": {"reward": -10, "from_laser": True},
+        "safe_distance": {"weight": -1.5},
+        "approach_goal": {"_on_safe_dist_violation": False},
+        "max_steps_exceeded": {"weight": 2.0},
+    }
+    fn = RewardFunction(spec)
+    rng = np.random.default_rng(0)
+    for _ in range(50):
+        inp = make_input(
+            goal_distance=rng.random(2) * 5,
+            goal_reached=rng.random(2) < 0.5,
+            min_range=rng.random(2) * 1.5,
+            collision=rng.random(2) < 0.3,
+            step=rng.integers(495, 505, 2),
+        )
+        out = fn(inp)
+        calm = ~(inp.min_range <= inp.safe_dist)
+        total = np.zeros(2)
+        done = np.zeros(2, bool)
+        reason = np.zeros(2, np.int64)
+        for name, term in fn.terms.items():
+            res = term(inp)
+            active = np.ones(2, bool) if fn.on_violation[name] else calm
+            r = np.where(active, fn.weights[name] * res.reward, 0.0)
+            assert out.terms[name].tobytes() == r.tobytes()
+            assert out.terms[name] is not res.reward
+            total += r
+            fired = res.done & active
+            done |= fired
+            reason = np.where(fired, np.maximum(reason, int(res.reason)), reason)
+        assert out.total.tobytes() == total.tobytes()
+        assert np.array_equal(out.done, done)
+        assert np.array_equal(out.reason, reason)

@@ -142,3 +142,31 @@ def test_never_samples_in_unknown_space(tmp_path):
         pts += list(ep.agents.waypoints.reshape(-1, 2))
         cells = grid.world_to_cell(np.array(pts))
         assert np.all(grid.data[cells[:, 0], cells[:, 1]] == 0)
+
+
+def test_batched_visibility_matches_line_of_sight():
+    """The waypoint kernel picks the first candidate that ``line_of_sight`` accepts."""
+    from arena.tasks.obstacle_modes.random import _first_visible
+
+    ep = generator(obstacles={"type": "random", "static": 3, "dynamic": 2}).episode(0)
+    grid = ep.grid
+    walkable = grid.free & ~grid.occupied
+    rng = np.random.default_rng(1)
+    lo = np.array(grid.origin) - 1.0
+    size = np.array([grid.width, grid.height]) * grid.resolution
+    hi = np.array(grid.origin) + size + 1.0
+    hits = 0
+    for _ in range(200):
+        a = rng.uniform(lo, hi)
+        pts = rng.uniform(lo, hi, size=(16, 2))
+        ok = rng.random(16) < 0.7
+        m = _first_visible(
+            pts, ok, float(a[0]), float(a[1]), float(grid.origin[0]), float(grid.origin[1]),
+            float(grid.resolution), grid.height, grid.width, walkable,
+        )
+        want = next(
+            (i for i in range(16) if ok[i] and line_of_sight(grid, walkable, a, pts[i])), -1
+        )
+        assert m == want
+        hits += m >= 0
+    assert hits > 10

@@ -133,7 +133,6 @@ from pydantic import BaseModel, ConfigDict, Field
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.neighbors import CellList
 from arena.crowd.state import CrowdState
-from arena.crowd.walls import world_segments
 from arena.sim.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
@@ -262,6 +261,7 @@ class PySocialModel:
         self._cells = CellList(self.obstacle_points, 1.0)
         self._blocks = _point_blocks(self._cells.points, self._cells.order, self._cells.starts)
         self._work: dict[str, NDArray[np.generic]] | None = None
+        self._groups_cache: tuple[IntArray, IntArray, IntArray] | None = None
 
     def neighbor_cutoff(self) -> float:
         """The social interaction range ``cutoff`` (m)."""
@@ -269,7 +269,10 @@ class PySocialModel:
 
     def reset(self, state: CrowdState, world: StaticWorld, rng: np.random.Generator) -> None:
         """Sample the episode's walls and obstacle edges into points, once."""
-        a, b = world_segments(world)
+        # the map's walls are traced once per map, not per episode (see grid_walls)
+        from arena.crowd.simulator import episode_segments
+
+        a, b = episode_segments(world)
         r = self.params.agent_radius
         r_max = float(r) if r is not None else float(np.max(state.radii, initial=0.0))
         self.set_obstacles(a, b, max_radius=r_max)
@@ -358,7 +361,7 @@ class PySocialModel:
             terms["obstacle"] *= p.obstacle_factor
 
         if p.enable_group:
-            order, starts = group_members(s.group)
+            order, starts = self._group_members(s.group)
             if starts.shape[0] > 1:
                 _groups(
                     pos,
@@ -386,6 +389,18 @@ class PySocialModel:
                 f *= p.force_scale
             acc += f
         return ModelOutput(accelerations=acc, forces=terms)
+
+    def _group_members(self, group: IntArray) -> tuple[IntArray, IntArray]:
+        """:func:`group_members` of ``group``, recomputed only when the groups change.
+
+        Groups are fixed for an episode, so the copy compared here nearly always matches.
+        """
+        cached = self._groups_cache
+        if cached is not None and np.array_equal(cached[0], group):
+            return cached[1], cached[2]
+        order, starts = group_members(group)
+        self._groups_cache = (np.array(group, copy=True), order, starts)
+        return order, starts
 
     def _social_term(
         self,

@@ -40,7 +40,10 @@ Differences from Arena, on purpose:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from arena.crowd.base import RobotView
@@ -61,7 +64,8 @@ from arena.crowd.social.perception import (
 from arena.crowd.social.robots import robot_avoidance as _avoidance
 from arena.crowd.social.robots import robot_fear
 from arena.crowd.state import AgentType, CrowdState, SocialState
-from arena.crowd.walls import WallIndex, grid_wall_segments
+from arena.crowd.walls import WallIndex
+from arena.maps.grid import OccupancyGrid
 from arena.sim.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
@@ -109,6 +113,178 @@ def _unit(v: FloatArray, fallback: FloatArray) -> FloatArray:
     return out
 
 
+_WALL_CACHE: list[tuple[FloatArray, WallIndex | None]] = []
+"""The last map's wall index (at most one entry): see :func:`_grid_wall_index`."""
+
+
+def _grid_wall_index(grid: OccupancyGrid) -> WallIndex | None:
+    """The wall index of ``grid`` (``None`` without walls), reused while the map stays the same.
+
+    An RL env builds a fresh crowd (so a fresh :class:`SocialStates`) every reset, mostly on
+    the same map; :func:`~arena.crowd.simulator.grid_walls` returns the same segment arrays
+    while the map is unchanged, and a :class:`WallIndex` is read-only once built.
+    """
+    from arena.crowd.simulator import grid_walls  # the simulator imports this module lazily
+
+    wa, wb = grid_walls(grid)
+    if _WALL_CACHE and _WALL_CACHE[0][0] is wa:
+        return _WALL_CACHE[0][1]
+    index = WallIndex(wa, wb) if wa.shape[0] else None
+    _WALL_CACHE[:] = [(wa, index)]
+    return index
+
+
+# The kernels below use the SocialState codes as literals (numba cannot read _S's attributes).
+assert (_S.IDLE, _S.WALKING, _S.RUNNING, _S.INTERACTING, _S.TALKING, _S.PHONE, _S.PANIC) == (
+    0, 1, 2, 3, 4, 5, 6
+)
+
+
+# -- the per-agent state machine ------------------------------------------------------------------
+# Element-wise transcriptions of the numpy formulation (same operations in the same order, no
+# fastmath), so that the levels, states and targets are bit-identical to it. ``_clip01`` and
+# ``_max0`` mirror numpy's clip/maximum exactly, signed zeros and NaN included.
+@njit(cache=True, inline="always")
+def _clip01(x: float) -> float:
+    if math.isnan(x):
+        return x
+    x = x if x > 0.0 else 0.0
+    return x if x < 1.0 else 1.0
+
+
+@njit(cache=True, inline="always")
+def _max0(x: float) -> float:
+    """``np.maximum(0.0, x)``."""
+    return 0.0 if x <= 0.0 else x  # NaN: x
+
+
+@njit(cache=True)
+def _levels_and_exits(
+    s0, rates, d_stress, d_energy, d_social, fear, with_fear, fear_scale, dt, t_in, min_time,
+    energy_lo, energy_hi, social_lo, social_hi, stress_hi, lost, stress, energy, social,
+    new, rest, talk_cand,
+):  # type: ignore[no-untyped-def]
+    """Levels, exits and panic of one tick; ``rest`` agents may start something new.
+
+    Advances ``stress/energy/social`` (rates of the state at the start of the tick, robot
+    fear, clipped to [0, 1]) and ``t_in`` by ``dt``; writes ``new`` (panic → running, leaving
+    → walking, panic), ``rest`` (walking or idle, past ``min_time``, not panicking) and
+    ``talk_cand`` (resting agents social enough to look for a partner).
+    """
+    for i in range(s0.shape[0]):
+        st = s0[i]
+        stress[i] += dt * (d_stress[i] + rates[i, st, 0])
+        energy[i] += dt * (d_energy[i] + rates[i, st, 1])
+        social[i] += dt * (d_social[i] + rates[i, st, 2])
+        if with_fear:
+            stress[i] += fear_scale * fear[i]
+        stress[i] = _clip01(stress[i])
+        energy[i] = _clip01(energy[i])
+        social[i] = _clip01(social[i])
+        t_in[i] += dt
+        ok = t_in[i] >= min_time[i]
+        nw = st
+        if st == 6:  # PANIC lasts one tick
+            nw = 2  # RUNNING
+        if st == 2 or st == 3:  # RUNNING, INTERACTING: energy-consuming
+            if (ok and energy[i] <= energy_lo[i]) or lost[i]:
+                nw = 1  # WALKING
+        elif (st == 4 or st == 5) and (  # TALKING, PHONE: social
+            (ok and social[i] <= social_lo[i]) or lost[i]
+        ):
+            nw = 1
+        panic = ok and stress[i] > stress_hi[i] and st != 6
+        if panic:
+            nw = 6
+            e, hi = energy[i], energy_hi[i]
+            energy[i] = e if (e >= hi or math.isnan(e)) else hi
+            stress[i] = stress_hi[i]
+        new[i] = nw
+        rest[i] = (st == 1 or st == 0) and ok and not panic
+        talk_cand[i] = rest[i] and social[i] >= social_hi[i]
+
+
+@njit(cache=True)
+def _chance_transitions(
+    s0, rest, talk, inter, u, social, energy, social_hi, energy_hi, energy_lo, idle_recovery,
+    dt, new, approach_q,
+):  # type: ignore[no-untyped-def]
+    """Talk, interact, phone, run, idle or walk again for the resting agents (into ``new``).
+
+    ``approach_q``: idle agents not yet recovered, who walk again if someone comes close.
+    """
+    for i in range(s0.shape[0]):
+        approach_q[i] = False
+        if talk[i]:
+            new[i] = 4  # TALKING
+            continue
+        if inter[i]:
+            new[i] = 3  # INTERACTING
+            continue
+        if not rest[i]:
+            continue
+        p_phone = 1.0 - (1.0 - _max0(social[i] - social_hi[i])) ** dt
+        if u[i, 0] < p_phone:
+            new[i] = 5  # PHONE
+            continue
+        p_run = 1.0 - (1.0 - _max0(energy[i] - energy_hi[i])) ** dt
+        if u[i, 1] < p_run:
+            new[i] = 2  # RUNNING
+            continue
+        if s0[i] == 1 and energy[i] <= energy_lo[i]:
+            new[i] = 0  # IDLE
+        elif s0[i] == 0:
+            lo = energy_lo[i]
+            if energy[i] >= lo + idle_recovery * (energy_hi[i] - lo):
+                new[i] = 1  # WALKING
+            else:
+                approach_q[i] = True
+
+
+@njit(cache=True)
+def _update_targets(
+    s0, new, talk, partner, inter, q_kind, q_tidx, q_tpoint, kind, tidx, tpoint, conv, t_in,
+    social_state,
+):  # type: ignore[no-untyped-def]
+    """Targets cleared on leaving a targeted state, set on entering one; commit ``new``.
+
+    Talkers join the partner's conversation if the partner keeps talking; else they start one
+    named after the lower index, so two agents choosing each other share it. The partner's
+    conversation is read after the clearing and before any talker's is written (two passes),
+    as the vectorised formulation did.
+    """
+    n = s0.shape[0]
+    for i in range(n):
+        targeted = new[i] == 4 or new[i] == 3
+        if not targeted or talk[i] or inter[i]:
+            kind[i] = 0
+            tidx[i] = -1
+            tpoint[i, 0] = np.nan
+            tpoint[i, 1] = np.nan
+            conv[i] = -1
+    joined = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        if talk[i]:
+            j = partner[i]
+            if s0[j] == 4 and new[j] == 4 and conv[j] >= 0:
+                joined[i] = conv[j]
+            else:
+                joined[i] = min(i, j)
+    for i in range(n):
+        if talk[i]:
+            kind[i] = 1  # TARGET_AGENT
+            tidx[i] = partner[i]
+            conv[i] = joined[i]
+        if inter[i]:
+            kind[i] = q_kind[i]
+            tidx[i] = q_tidx[i]
+            tpoint[i, 0] = q_tpoint[i, 0]
+            tpoint[i, 1] = q_tpoint[i, 1]
+        if new[i] != s0[i]:
+            t_in[i] = 0.0
+        social_state[i] = new[i]
+
+
 class SocialStates:
     """The social-state statechart for a whole crowd (struct of arrays, index ``i``).
 
@@ -127,6 +303,11 @@ class SocialStates:
 
     def __init__(self, params: SocialStatesParams | None = None) -> None:
         self.params = params or SocialStatesParams()
+        f = self.params.human.vmax_factors
+        # vmax factor by state code (talking/interacting: approach until gathered)
+        self._vmax_table = np.array(
+            [f.idle, f.walking, f.running, f.approach, f.approach, f.phone, f.panic]
+        )
         self._init_arrays(0)
         self._rng = np.random.default_rng(0)
         self._obstacles: WallIndex | None = None
@@ -215,9 +396,7 @@ class SocialStates:
             if world.segments_a.shape[0]:
                 self._obstacles = WallIndex(world.segments_a, world.segments_b)
             if self.params.interact_with_walls:
-                wa, wb = grid_wall_segments(world.grid)
-                if wa.shape[0]:
-                    self._walls = WallIndex(wa, wb)
+                self._walls = _grid_wall_index(world.grid)
 
     # -- step: before the model -----------------------------------------------------------------
     def pre(
@@ -242,32 +421,26 @@ class SocialStates:
         p = self._p
         pos = state.positions
         s0 = state.social_state.copy()
-        self._t_in += dt
-
-        self._update_levels(state, robots, s0, dt)
-        stress, energy, social = state.stress, state.energy, state.social
-        ok = self._t_in >= p["min_time_in_state"]
-        new = s0.copy()
-
-        # Transient and exits (from the state at the start of the tick).
-        new[s0 == _S.PANIC] = _S.RUNNING
+        # The per-agent state machine runs in two numba kernels around the perception queries
+        # (partners, interests, approaching agents), which stay vectorised; the kernels do
+        # exactly the arithmetic of the former numpy formulation, element by element, so the
+        # results are bit-identical (a tick used to cost ~60 small numpy calls).
         lost = self._target_lost(state, robots, s0)
-        energy_act = (s0 == _S.RUNNING) | (s0 == _S.INTERACTING)
-        social_act = (s0 == _S.TALKING) | (s0 == _S.PHONE)
-        leave = energy_act & ((ok & (energy <= p["energy_lo"])) | lost)
-        leave |= social_act & ((ok & (social <= p["social_lo"])) | lost)
-        new[leave] = _S.WALKING
-
-        # Panic pre-empts everything else.
-        panic = ok & (stress > p["stress_hi"]) & (s0 != _S.PANIC)
-        new[panic] = _S.PANIC
-        energy[panic] = np.maximum(energy[panic], p["energy_hi"][panic])
-        stress[panic] = p["stress_hi"][panic]
+        fear = self._fear(state, robots)
+        new = np.empty_like(s0)
+        rest = np.empty(n, dtype=bool)
+        talk_cand = np.empty(n, dtype=bool)
+        _levels_and_exits(
+            s0, self._rates, p["d_stress"], p["d_energy"], p["d_social"], fear,
+            len(robots) > 0, dt * self.params.fear_rate_hz, dt, self._t_in, p["min_time_in_state"],
+            p["energy_lo"], p["energy_hi"], p["social_lo"], p["social_hi"], p["stress_hi"],
+            lost, state.stress, state.energy, state.social, new, rest, talk_cand,
+        )
+        energy = state.energy
 
         # Rest: events first (talk, interact), then chance (phone, run), then idle/walk.
-        rest = ((s0 == _S.WALKING) | (s0 == _S.IDLE)) & ok & ~panic
         cells = None
-        talk_q = np.flatnonzero(rest & (social >= p["social_hi"]))
+        talk_q = np.flatnonzero(talk_cand)
         partner = np.full(n, -1, dtype=np.int64)
         if talk_q.shape[0]:
             cells = CellList(pos, max(self._vision.reach, 1e-3))
@@ -276,82 +449,47 @@ class SocialStates:
         inter, kind, tidx, tpoint = self._find_interest(
             state, robots, np.flatnonzero(rest & ~talk & (energy >= p["energy_hi"]))
         )
-        free = rest & ~talk & ~inter
         # Drawn for every agent every tick, so the stream does not depend on who is eligible.
         u = self._rng.random((n, 2))
-        p_phone = 1.0 - (1.0 - np.maximum(0.0, social - p["social_hi"])) ** dt
-        p_run = 1.0 - (1.0 - np.maximum(0.0, energy - p["energy_hi"])) ** dt
-        phone = free & (u[:, 0] < p_phone)
-        run = free & ~phone & (u[:, 1] < p_run)
-        calm = free & ~phone & ~run
-        to_idle = calm & (s0 == _S.WALKING) & (energy <= p["energy_lo"])
-        idle_q = calm & (s0 == _S.IDLE)
-        recovered = energy >= p["energy_lo"] + self.params.idle_recovery * (
-            p["energy_hi"] - p["energy_lo"]
+        approach_q = np.empty(n, dtype=bool)
+        _chance_transitions(
+            s0, rest, talk, inter, u, state.social, energy, p["social_hi"], p["energy_hi"],
+            p["energy_lo"], self.params.idle_recovery, dt, new, approach_q,
         )
-        to_walk = idle_q & recovered
         if self.params.wake_on_approach:
-            to_walk |= self._approached(state, robots, np.flatnonzero(idle_q & ~recovered), cells)
-        new[talk] = _S.TALKING
-        new[inter] = _S.INTERACTING
-        new[phone] = _S.PHONE
-        new[run] = _S.RUNNING
-        new[to_idle] = _S.IDLE
-        new[to_walk] = _S.WALKING
-
-        # Targets: cleared on leaving a targeted state, set on entering one.
-        targeted = (new == _S.TALKING) | (new == _S.INTERACTING)
-        clear = ~targeted | talk | inter
-        self._kind[clear] = TARGET_NONE
-        self._tidx[clear] = -1
-        self._tpoint[clear] = np.nan
-        self._conv[clear] = -1
-        ti = np.flatnonzero(talk)
-        if ti.shape[0]:
-            j = partner[ti]
-            self._kind[ti] = TARGET_AGENT
-            self._tidx[ti] = j
-            # Join the partner's conversation if it keeps talking; else start one named after
-            # the lower index, so two agents choosing each other share it.
-            joins = (s0[j] == _S.TALKING) & (new[j] == _S.TALKING) & (self._conv[j] >= 0)
-            self._conv[ti] = np.where(joins, self._conv[j], np.minimum(ti, j))
-        self._kind[inter] = kind[inter]
-        self._tidx[inter] = tidx[inter]
-        self._tpoint[inter] = tpoint[inter]
-
-        changed = new != s0
-        self._t_in[changed] = 0.0
-        state.social_state[:] = new
+            query = np.flatnonzero(approach_q)
+            if query.shape[0]:
+                new[self._approached(state, robots, query, cells)] = _S.WALKING
+        _update_targets(
+            s0, new, talk, partner, inter, kind, tidx, tpoint,
+            self._kind, self._tidx, self._tpoint, self._conv, self._t_in, state.social_state,
+        )
         self._set_destinations(state, robots)
         self._set_vmax_factors(state)
         self._robot_pos = np.array(robots.positions, dtype=np.float64).reshape(-1, 2)
         if self.params.robot_avoidance.enabled:
             self._avoid = self.robot_avoidance(state, robots)
 
-    def _update_levels(self, state: CrowdState, robots: RobotView, s0: IntArray, dt: float) -> None:
+    def _fear(self, state: CrowdState, robots: RobotView) -> FloatArray:
+        """``(n,)`` Arena's per-tick stress from robots (zeros without robots)."""
+        if not len(robots):
+            return np.zeros(len(state))
         p = self._p
-        n = len(state)
-        rates = self._rates[np.arange(n), s0]
-        state.stress += dt * (p["d_stress"] + rates[:, 0])
-        state.energy += dt * (p["d_energy"] + rates[:, 1])
-        state.social += dt * (p["d_social"] + rates[:, 2])
-        if len(robots):
-            fear = robot_fear(
-                state.positions,
-                p["personal_space_radius"],
-                p["fear_robot"],
-                p["fear_robot_speed_tolerance"],
-                robots,
-            )
-            state.stress += dt * self.params.fear_rate_hz * fear
-        for name in LEVEL_NAMES:
-            np.clip(getattr(state, name), 0.0, 1.0, out=getattr(state, name))
+        return robot_fear(
+            state.positions,
+            p["personal_space_radius"],
+            p["fear_robot"],
+            p["fear_robot_speed_tolerance"],
+            robots,
+        )
 
     def _target_lost(self, state: CrowdState, robots: RobotView, s0: IntArray) -> BoolArray:
         """Talking/interacting agents whose partner or target is no longer perceived."""
         n = len(state)
         lost = np.zeros(n, dtype=bool)
         has = (s0 == _S.TALKING) | (s0 == _S.INTERACTING)
+        if not has.any():  # the common tick: nobody has a partner or target to lose
+            return lost
         lost[has & (self._kind == TARGET_NONE)] = True
         pos, hd = state.positions, state.headings
         ia = np.flatnonzero(has & (self._kind == TARGET_AGENT))
@@ -465,11 +603,13 @@ class SocialStates:
 
     def _set_vmax_factors(self, state: CrowdState) -> None:
         f = self.params.human.vmax_factors
-        table = np.array([f.idle, f.walking, f.running, f.approach, f.approach, f.phone, f.panic])
+        table = self._vmax_table
         ss = state.social_state
-        vf = table[np.clip(ss, 0, _N_STATES - 1)]
-        vf[(ss == _S.TALKING) & self._gathered] = f.talking
-        vf[(ss == _S.INTERACTING) & self._gathered] = f.interacting
+        # min/max: np.clip's Python wrapper costs more than the work for 20 agents
+        vf = table[np.minimum(np.maximum(ss, 0), _N_STATES - 1)]
+        if self._gathered.any():
+            vf[(ss == _S.TALKING) & self._gathered] = f.talking
+            vf[(ss == _S.INTERACTING) & self._gathered] = f.interacting
         state.vmax_factor[:] = vf
 
     # -- step: after the model ------------------------------------------------------------------
@@ -537,8 +677,10 @@ class SocialStates:
         n = len(state)
         if n == 0:
             return
-        pos = state.positions
         ss = state.social_state
+        if not self._gathered.any():  # only gathered talkers and interactors are turned
+            return
+        pos = state.positions
         talking = (ss == _S.TALKING) & (self._kind == TARGET_AGENT) & (self._conv >= 0)
         look = np.full((n, 2), np.nan)
         if talking.any():

@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -27,7 +28,7 @@ from arena.maps.raster import polygon_mask
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn
-from arena.tasks.sampling import clearance_map, components, jitter, line_of_sight
+from arena.tasks.sampling import clearance_map, components, jitter
 
 BOX = "box"
 """Pseudo-model: a cuboid with random edge lengths."""
@@ -245,11 +246,18 @@ def place_pedestrians(
     waypoints = np.full((n, n_wp, 2), np.nan)
     order = np.argsort(cell_labels, kind="stable")
     bounds = np.searchsorted(cell_labels[order], np.arange(cell_labels.max(initial=0) + 2))
+    # The cells of each region, gathered once per region: most pedestrians share the one big
+    # region, and gathering its cells (a fancy-index copy of most of the map) per pedestrian
+    # was the bulk of a reset.
+    regions: dict[int, NDArray[np.int64]] = {}
     for i in range(n):
         chain = [starts[i]]
         r, c = grid.world_to_cell(starts[i])
-        lab = labels[r, c]
-        region_cells = cells[order[bounds[lab] : bounds[lab + 1]]] if lab else cells[:0]
+        lab = int(labels[r, c])
+        region_cells = regions.get(lab)
+        if region_cells is None:
+            region_cells = cells[order[bounds[lab] : bounds[lab + 1]]] if lab else cells[:0]
+            regions[lab] = region_cells
         for _ in range(k):
             chain.append(_next_waypoint(grid, walkable, region_cells, chain[-1], rng, p))
         trip = chain[1:] + chain[-2::-1]
@@ -286,8 +294,52 @@ def _next_waypoint(
             pts = jitter(grid, batch, rng)
             d = np.hypot(*(pts - prev).T)
             ok = (d >= min(lo, 0.5)) if near_ok else (d >= lo) & (d <= hi)
-            for xy in pts[ok]:
-                if line_of_sight(grid, walkable, prev, xy):
-                    return np.asarray(xy, dtype=np.float64)
+            m = _first_visible(
+                pts, ok, float(prev[0]), float(prev[1]), float(grid.origin[0]),
+                float(grid.origin[1]), float(grid.resolution), grid.height, grid.width, walkable,
+            )
+            if m >= 0:
+                return np.array(pts[m], dtype=np.float64)
     # No visible waypoint (a tiny enclosed pocket): stay put rather than cross a wall.
     return np.array(prev, dtype=np.float64)
+
+
+@njit(cache=True)
+def _first_visible(
+    pts: NDArray[np.float64],
+    ok: NDArray[np.bool_],
+    ax: float,
+    ay: float,
+    ox: float,
+    oy: float,
+    res: float,
+    height: int,
+    width: int,
+    allowed: NDArray[np.bool_],
+) -> int:
+    """Index of the first ``ok`` point in line of sight of ``(ax, ay)``, or -1.
+
+    :func:`~arena.tasks.sampling.line_of_sight` for a batch of candidates, operation for
+    operation (``np.linspace`` sample parameters ``i · (1/k)`` with the last exactly 1, the
+    same cell flooring), so the chosen waypoints are bit-identical; a reset tests thousands
+    of candidate legs, which cost ~60 µs each as separate numpy calls.
+    """
+    for m in range(pts.shape[0]):
+        if not ok[m]:
+            continue
+        dx = pts[m, 0] - ax
+        dy = pts[m, 1] - ay
+        length = np.hypot(dx, dy)
+        k = max(int(np.ceil(length / (res / 3.0))), 1)
+        step = 1.0 / k
+        visible = True
+        for i in range(k + 1):
+            t = 1.0 if i == k else float(i) * step + 0.0
+            col = int(np.floor((ax + t * dx - ox) / res))
+            row = int(np.floor((ay + t * dy - oy) / res))
+            if row < 0 or row >= height or col < 0 or col >= width or not allowed[row, col]:
+                visible = False
+                break
+        if visible:
+            return m
+    return -1
