@@ -139,6 +139,11 @@ class Contestant(_Arena):
     name: str
     local_planner: str = Field(description="local planner name")
     inter_planner: str = Field("bypass", description="Arena's intermediate planner")
+    params: dict[str, Any] = Field(
+        default_factory=dict,
+        description="local planner parameters (our addition to Arena's format), e.g. "
+        "{weights: runs/x/policy.npz} for rosnav_rl",
+    )
 
 
 class ContestFile(_Arena):
@@ -466,7 +471,12 @@ def contestant_config(
         raise ConfigError(e.message, source=source, path=where) from None
     data = base_cfg.model_dump(mode="json")
     nav = data["navigation"]
-    nav["local_planner"] = {"type": contestant.local_planner}
+    block = {**contestant.params, "type": contestant.local_planner}
+    try:
+        LOCAL_PLANNERS.validate(block, path="local_planner")
+    except ConfigError as e:
+        raise ConfigError(e.message, source=source, path=f"contestants[{index}].params") from None
+    nav["local_planner"] = block
     return ExperimentConfig.model_validate({**data, "name": contestant.name})
 
 

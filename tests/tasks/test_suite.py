@@ -199,3 +199,18 @@ def test_unknown_key_and_malformed_yaml(tmp_path):
         load_suite(f)
     with pytest.raises(ConfigError, match="packaged: indoor_people, paper, quick"):
         load_suite("papr")
+
+
+def test_contestant_planner_params(tmp_path):
+    from arena.tasks.suite import contestant_config
+
+    f = _write(tmp_path, "contestants:\n  - {name: slow, local_planner: dwa, "
+               "params: {max_speed: 0.4}}\n", "contest.yaml")
+    contest, _ = load_contest(f)
+    cfg = contestant_config(ExperimentConfig(), contest.contestants[0], source=str(f))
+    assert cfg.navigation.local_planner == {"type": "dwa", "max_speed": 0.4}
+    bad = _write(tmp_path, "contestants:\n  - {name: x, local_planner: dwa, "
+                 "params: {max_sped: 0.4}}\n", "bad.yaml")
+    with pytest.raises(ConfigError, match="max_sped") as e:
+        contestant_config(ExperimentConfig(), load_contest(bad)[0].contestants[0], source=str(bad))
+    assert e.value.path == "contestants[0].params"
