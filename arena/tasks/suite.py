@@ -475,7 +475,9 @@ def contestant_config(
     try:
         LOCAL_PLANNERS.validate(block, path="local_planner")
     except ConfigError as e:
-        raise ConfigError(e.message, source=source, path=f"contestants[{index}].params") from None
+        sub = (e.path or "").removeprefix("local_planner").lstrip(".")
+        path = f"contestants[{index}].params" + (f".{sub}" if sub else "")
+        raise ConfigError(e.message, source=source, path=path) from None
     nav["local_planner"] = block
     return ExperimentConfig.model_validate({**data, "name": contestant.name})
 

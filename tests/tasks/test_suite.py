@@ -211,6 +211,6 @@ def test_contestant_planner_params(tmp_path):
     assert cfg.navigation.local_planner == {"type": "dwa", "max_speed": 0.4}
     bad = _write(tmp_path, "contestants:\n  - {name: x, local_planner: dwa, "
                  "params: {max_sped: 0.4}}\n", "bad.yaml")
-    with pytest.raises(ConfigError, match="max_sped") as e:
+    with pytest.raises(ConfigError, match=r"params\.max_sped: unknown key") as e:
         contestant_config(ExperimentConfig(), load_contest(bad)[0].contestants[0], source=str(bad))
-    assert e.value.path == "contestants[0].params"
+    assert e.value.path == "contestants[0].params.max_sped"
