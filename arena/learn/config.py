@@ -73,7 +73,7 @@ class SubgoalObsConfig(_Strict):
 
     At reset a global path is planned (A* on the episode's planning grid, inflated by the robot
     radius + ``navigation.inflation_margin`` as the navigation stack does); each step the
-    ``goal`` observation is ``[ρ, θ]`` of :func:`~arena.learn.observations.subgoal_on_path`.
+    ``goal`` observation is ``[ρ, θ]`` of :func:`~arena.learn.paths.subgoal_on_path`.
     Rewards keep using the final goal.
     """
 

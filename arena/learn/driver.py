@@ -31,13 +31,8 @@ from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
 from arena.learn.actions import ActionDecoder
 from arena.learn.config import EnvConfig, SubgoalObsConfig
-from arena.learn.observations import (
-    Obs,
-    ObservationBuilder,
-    ObsInput,
-    project_on_path,
-    subgoal_on_path,
-)
+from arena.learn.observations import Obs, ObservationBuilder, ObsInput
+from arena.learn.paths import project_on_path, subgoal_on_path
 from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput
 from arena.maps.raster import polygon_mask
 from arena.nav.global_planners.astar import AStarPlanner
@@ -112,7 +107,7 @@ class SubgoalTracker:
     ``navigation.inflation_margin``, as the navigation stack does) and an A* path planned per
     robot; :meth:`update` replans every ``replan_period`` s and whenever a robot is more than
     ``max_deviation`` m from its path, then moves each subgoal to
-    :func:`~arena.learn.observations.subgoal_on_path`. A robot whose start lies in the
+    :func:`~arena.learn.paths.subgoal_on_path`. A robot whose start lies in the
     inflated zone plans from the nearest free cell (its position prepended); when no path exists
     the straight segment to the goal stands in, so an episode never fails for want of a plan.
     """

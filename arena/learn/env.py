@@ -19,7 +19,7 @@ Observation Space:
     + ``navigation.inflation_margin``), replanned every ``replan_period`` s (1.0) or when the
     robot strays more than ``max_deviation`` m (1.0) from it, and the subgoal is the path point
     ``horizon`` m (5.0) ahead of the robot's projection on it, or the goal when it is closer
-    (:func:`~arena.learn.observations.subgoal_on_path`).
+    (:func:`~arena.learn.paths.subgoal_on_path`).
 
 Rewards:
     The configured reward terms (:mod:`arena.learn.rewards`), Arena's ``default.yaml`` unless

@@ -9,7 +9,8 @@ from gymnasium.utils.env_checker import check_env
 from arena.learn.config import SubgoalObsConfig
 from arena.learn.driver import SubgoalTracker
 from arena.learn.env import SocialNavEnv
-from arena.learn.observations import goal_polar, project_on_path, subgoal_on_path
+from arena.learn.observations import goal_polar
+from arena.learn.paths import project_on_path, subgoal_on_path
 from arena.maps.grid import OccupancyGrid
 from tests.learn.helpers import small_cfg, small_robot
 from tests.learn.test_env import _equal, rollout

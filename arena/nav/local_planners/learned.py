@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import ConfigError
-from arena.learn.observations import subgoal_on_path
+from arena.learn.paths import subgoal_on_path
 from arena.learn.policy import NumpyPolicy
 from arena.nav.local_planners.base import LOCAL_PLANNERS, LocalObservation
 from arena.nav.local_planners.path_tracking import finish_command
