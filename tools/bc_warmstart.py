@@ -16,7 +16,7 @@ already reaches the goal in 80 % of the batched env's episodes, so the actor sta
    ``arena train --resume RUN --steps N`` continues with PPO.
 
     python tools/bc_warmstart.py arena/learn/data/train/rosnav_rl.yaml -o runs/rosnav_rl \\
-        [--samples 200000] [--epochs 8] [--log-std -1.0]
+        [--samples 200000] [--epochs 8] [--log-std -1.0] [--max-speed 1.0] [--slow-distance 1.0]
 """
 
 from __future__ import annotations
@@ -33,11 +33,16 @@ from pathlib import Path
 import numpy as np
 
 
-def expert(obs: dict[str, np.ndarray], low: np.ndarray, high: np.ndarray) -> np.ndarray:
+def expert(
+    obs: dict[str, np.ndarray], low: np.ndarray, high: np.ndarray,
+    max_speed: float = 1.0, slow_distance: float = 1.0,
+) -> np.ndarray:
     """Normalised ``[v, ω]`` actions of the subgoal follower for raw (unnormalised) obs.
 
-    Turn toward the subgoal (ω = 1.5·θ), drive at up to 1 m/s scaled by cos θ, and slow down
-    linearly when the closest return within ±15° ahead is nearer than 1.4 m.
+    Turn toward the subgoal (ω = 1.5·θ), drive at up to ``max_speed`` m/s scaled by cos θ, and
+    slow down linearly when the closest return within ±11° ahead is nearer than
+    ``0.4 + slow_distance`` m. In the batched env (64 episodes, seed 99): 1.0/1.0 reaches 53 goals
+    in 19.1 s on average, 1.6/1.6 54 in 11.2 s, 2.0/2.5 53 in 8.6 s with more collisions.
     """
     th = obs["goal"][:, 1]
     lid = obs["lidar"][:, -1, :]
@@ -45,7 +50,9 @@ def expert(obs: dict[str, np.ndarray], low: np.ndarray, high: np.ndarray) -> np.
     c = beams // 2  # the jackal's 720 beams span ±π: beam beams/2 looks straight ahead
     w = max(1, beams // 24)
     front = lid[:, c - w : c + w].min(axis=1)
-    v = np.clip(1.0 * np.cos(th), 0.0, 1.0) * np.clip((front - 0.4) / 1.0, 0.0, 1.0)
+    v = np.clip(max_speed * np.cos(th), 0.0, max_speed) * np.clip(
+        (front - 0.4) / slow_distance, 0.0, 1.0
+    )
     om = np.clip(1.5 * th, -1.0, 1.0)
     raw = np.stack([v, om], axis=1)
     return (2.0 * (raw - low) / (high - low) - 1.0).astype(np.float32)
@@ -60,6 +67,9 @@ def main() -> None:
     ap.add_argument("--epochs", type=int, default=8)
     ap.add_argument("--log-std", type=float, default=-1.0)
     ap.add_argument("--lr", type=float, default=1e-3)
+    ap.add_argument("--max-speed", type=float, default=1.0, help="m/s, the expert's top speed")
+    ap.add_argument("--slow-distance", type=float, default=1.0,
+                    help="m, the expert slows down over this distance before obstacles")
     args = ap.parse_args()
 
     import torch
@@ -100,7 +110,7 @@ def main() -> None:
     successes = episodes = 0
     for _ in range(steps):
         raw = venv.get_original_obs()
-        a = expert(raw, low, high)
+        a = expert(raw, low, high, args.max_speed, args.slow_distance)
         for k in keys:
             buf_obs[k].append(obs[k].copy())
         acts.append(a)

@@ -364,21 +364,27 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         n = self.num_envs
         m = state.ped_positions.shape[1]
         goals = self._goals if self.trackers is None else self._subgoals
+        ocfg = self.env_cfg.observation
+        if m == 0:
+            ped_pos, ped_vel = np.zeros((n, 0, 2)), np.zeros((n, 0, 2))
+            ped_kind, ped_state = np.zeros((n, 0), np.int64), np.zeros((n, 0), np.int64)
+            ped_mask = np.zeros((n, 0), bool)
+        else:
+            ped_pos, ped_vel = state.ped_positions, state.ped_velocities
+            ped_kind, ped_mask = state.ped_kinds, state.ped_mask
+            # the builder reads ped_state only for the pedestrian/semantic parts
+            ped_state = (
+                np.maximum(state.ped_states, 0)
+                if ocfg.pedestrians.enabled or ocfg.semantic.enabled
+                else state.ped_states
+            )
         inp = ObsInput(
             poses=state.poses, twists=state.twists, goals=goals, scans=self._scans,
-            last_action=self._last_action, ped_pos=state.ped_positions,
-            ped_vel=state.ped_velocities, ped_kind=state.ped_kinds,
-            ped_state=np.maximum(state.ped_states, 0), ped_mask=state.ped_mask,
+            last_action=self._last_action, ped_pos=ped_pos, ped_vel=ped_vel, ped_kind=ped_kind,
+            ped_state=ped_state, ped_mask=ped_mask,
         )
-        if m == 0:
-            inp = ObsInput(
-                poses=inp.poses, twists=inp.twists, goals=inp.goals, scans=inp.scans,
-                last_action=inp.last_action, ped_pos=np.zeros((n, 0, 2)),
-                ped_vel=np.zeros((n, 0, 2)), ped_kind=np.zeros((n, 0), np.int64),
-                ped_state=np.zeros((n, 0), np.int64), ped_mask=np.zeros((n, 0), bool),
-            )
         obs: Obs = self.obs_builder.build(inp)
-        if self.env_cfg.observation.flatten:
+        if ocfg.flatten:
             return self.obs_builder.flatten(obs)
         return obs
 

@@ -224,6 +224,7 @@ class BatchSim:
         self._alloc_peds(0, 1)
         self._rand = np.zeros((n, _RAND_TABLE))
         self._rand_k = np.zeros(n, dtype=np.int64)
+        self._slots = np.arange(0)  # pedestrian slot indices (_snapshot's mask)
 
     # -- public API ------------------------------------------------------------------------------
     @property
@@ -589,12 +590,19 @@ class BatchSim:
         self._groups = [(kin, np.array(idx, dtype=np.int64)) for kin, idx in groups.values()]
 
     def _snapshot(self) -> BatchState:
-        kind = np.where(
-            self._wall, K.KIND_WALL,
-            np.where(self._obstacle >= 0, K.KIND_OBSTACLE,
-                     np.where(self._agent >= 0, K.KIND_PEDESTRIAN, K.KIND_NONE)),
-        ).astype(np.int64)
-        mask = np.arange(self._pos.shape[1])[None, :] < self._ped_n[:, None]
+        # Same values as nested np.where(wall, WALL, where(obstacle, OBSTACLE, where(agent, ...)))
+        # but in place on one array (the lowest-priority kind first, overwritten by higher ones).
+        kind = np.full(self.num_worlds, K.KIND_NONE, dtype=np.int64)
+        kind[self._agent >= 0] = K.KIND_PEDESTRIAN
+        kind[self._obstacle >= 0] = K.KIND_OBSTACLE
+        kind[self._wall] = K.KIND_WALL
+        p = self._pos.shape[1]
+        slots = self._slots
+        if slots.shape[0] != p:
+            slots = self._slots = np.arange(p)
+        mask = slots[None, :] < self._ped_n[:, None]
+        states = mask.astype(np.int64)  # np.where(mask, 0, -1) as 1/0 minus 1
+        states -= 1
         return BatchState(
             time=self._time.copy(), step=self._step.copy(), poses=self._poses.copy(),
             twists=self._twists.copy(), commands=self._commands.copy(),
@@ -602,5 +610,5 @@ class BatchSim:
             wall=self._wall.copy(), obstacle=self._obstacle.copy(), agent=self._agent.copy(),
             ped_positions=self._pos.copy(), ped_velocities=self._vel.copy(),
             ped_headings=self._heading.copy(), ped_radii=self._pradii.copy(), ped_mask=mask,
-            ped_kinds=self._kinds.copy(), ped_states=np.where(mask, 0, -1),
+            ped_kinds=self._kinds.copy(), ped_states=states,
         )
