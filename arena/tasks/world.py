@@ -22,13 +22,13 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import ndimage
 
 from arena.core.errors import SamplingError
 from arena.core.geometry import point_segment_distance, points_in_polygon
 from arena.maps.grid import OccupancyGrid
 from arena.maps.raster import disk_mask, polygon_mask
 from arena.sim.state import Obstacle
+from arena.tasks.sampling import squared_edt
 
 FloatArray = NDArray[np.float64]
 
@@ -55,8 +55,7 @@ def wall_distance_map(grid: OccupancyGrid) -> FloatArray:
 
     Unknown cells and the space outside the map count as walls.
     """
-    blocked = np.pad(~grid.free, 1, constant_values=True)
-    return ndimage.distance_transform_edt(~blocked)[1:-1, 1:-1] * grid.resolution
+    return np.sqrt(squared_edt(~grid.free)) * grid.resolution
 
 
 class WorldSampler:
