@@ -31,28 +31,11 @@ from tests.nav.planner_kit import (
 )
 from tests.nav.planner_kit import line as _line
 from tests.nav.planner_kit import obs as _obs
+from tests.nav.planner_kit import post_scan as _post_scan
 from tests.nav.planner_kit import step as _step
+from tests.nav.planner_kit import wall_scan as _wall_scan
 
 NAMES = ["social_force", "orca"]
-
-
-def _wall_scan(pose: np.ndarray, wall_x: float, n: int = 360) -> tuple[np.ndarray, np.ndarray]:
-    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
-    world = angles + pose[2]
-    with np.errstate(divide="ignore"):
-        t = (wall_x - pose[0]) / np.cos(world)
-    return np.where((t > 0) & (t < 8.0), t, np.inf), angles
-
-
-def _post_scan(pose: np.ndarray, centre: np.ndarray, radius: float,
-               n: int = 360) -> tuple[np.ndarray, np.ndarray]:
-    angles = np.linspace(-math.pi, math.pi, n, endpoint=False)
-    d = np.stack([np.cos(angles + pose[2]), np.sin(angles + pose[2])], axis=-1)
-    rel = centre - pose[:2]
-    b = d @ rel
-    disc = b * b - (rel @ rel - radius * radius)
-    t = b - np.sqrt(np.maximum(disc, 0.0))
-    return np.where((disc >= 0) & (t > 0), t, np.inf), angles
 
 
 def test_registered_types() -> None:
