@@ -1,7 +1,10 @@
 """``BatchSim``: ``N`` independent single-robot worlds stepped together in array operations.
 
 Built for RL training, where many short episodes run side by side: one call steps every world,
-and the heavy parts (lidar, crowd, contacts) are numba kernels running ``prange`` over worlds.
+and the heavy parts (lidar, crowd, contacts) are numba kernels running ``prange`` over worlds;
+:meth:`BatchSim.step` runs them fused per world in one kernel
+(:func:`~arena.sim.batch.kernels.step_worlds`: one thread-pool launch per step), with dynamic
+scheduling so that a thread slowed by other load on a shared machine does not hold up the rest.
 World ``i`` only ever reads its own slices, so its trajectory does not depend on ``N``, on the
 other worlds or on the thread count, and :meth:`BatchSim.reset_world` restarts one finished
 world without touching the others (auto-reset).
@@ -163,6 +166,12 @@ class BatchSim:
         robot_radius: float | None = Field(
             None, gt=0, description="m, contact circle; None: the robot's circumscribed radius"
         )
+        parallel_chunksize: int = Field(
+            1, ge=0, description=(
+                "worlds a thread takes at a time in the fused step kernel (dynamic "
+                "scheduling: a thread slowed by other load takes fewer); 0: numba's static split"
+            ),
+        )
 
     # padded pedestrian arrays, (N, P, ...), allocated by _alloc_peds
     _pos: F64
@@ -225,6 +234,7 @@ class BatchSim:
         self._rand = np.zeros((n, _RAND_TABLE))
         self._rand_k = np.zeros(n, dtype=np.int64)
         self._slots = np.arange(0)  # pedestrian slot indices (_snapshot's mask)
+        self._all = np.ones(n, dtype=bool)  # the crowd kernels' "active" flags
 
     # -- public API ------------------------------------------------------------------------------
     @property
@@ -326,22 +336,60 @@ class BatchSim:
             raise SimulationError("commands must be finite")
         if not dt > 0:
             raise SimulationError(f"dt must be > 0 s, got {dt}")
-        self._crowd(dt)
+        # The stages of _crowd, _kinematics, _contacts, the collision response and _scan, in
+        # that order, but with everything after the (vectorised) kinematics fused per world in
+        # one kernel: one thread-pool launch per step instead of three. The kinematics do not
+        # read the pedestrians, so running them first changes nothing.
+        spec = self.lidar_spec
         new_p, new_t, new_s = self._kinematics(cmd, dt)
         old = self._poses
-        self._poses = new_p
-        self._contacts(sweep=True, previous=old)
-        if self.params.collision_response == "stop":
-            blocked = self._wall | (self._obstacle >= 0) | (self._agent >= 0)
-            new_p[blocked] = old[blocked]
-            new_t[blocked] = 0.0
-            new_s[blocked] = self._steer[blocked]
-        self._twists, self._steer = new_t, new_s
-        self._commands = cmd.copy()
+        crowd = self.params.pedestrians != "static" and self._pos.shape[1] > 0
+        if crowd:
+            out_pos = np.empty_like(self._pos)
+            out_vel = np.empty_like(self._vel)
+        else:
+            out_pos, out_vel = self._pos, self._vel
         self._time += dt
         self._step += 1
-        period = 1.0 / self.lidar_spec.update_rate
-        self._scan(self._time - self._last_scan >= period - 1e-9)
+        if self.params.lidar:
+            due = self._time - self._last_scan >= 1.0 / spec.update_rate - 1e-9
+            self._last_scan[due] = self._time[due]
+        else:
+            due = np.zeros(n, dtype=bool)
+        wall = np.zeros(n, dtype=bool)
+        obstacle = np.full(n, -1, dtype=np.int64)
+        agent = np.full(n, -1, dtype=np.int64)
+        parallel = self._parallel(n)
+        kernel = K.step_worlds if parallel else K.step_worlds_serial
+        chunk = self.params.parallel_chunksize if parallel else 0
+        # Worlds differ in cost (a scan in a corridor ends sooner than one across a hall) and a
+        # shared core may stall one thread; with dynamic chunks the other thread picks up the
+        # rest. Which thread steps a world never changes its result.
+        previous_chunk = numba.set_parallel_chunksize(chunk)
+        try:
+            kernel(
+                crowd, self.params.collision_response == "stop",
+                self._all, self._pos, self._vel, self._heading, self._pradii, self._vmax,
+                self._ped_n, self._wps, self._n_wp, self._wp_mode, self._wp_idx, self._rand,
+                self._rand_k, self._dist, self._offs, self._shapes, self._res, self._origin,
+                self._seg_a, self._seg_b, self._seg_owner, self._seg_n, self._radius,
+                self._crowd_prm, float(dt), out_pos, out_vel,
+                old, new_p, new_t, new_s, self._steer, wall, obstacle, agent,
+                due, self._mount, self._cos, self._sin, spec.angle_min, self._inc,
+                spec.range_min, spec.range_max, self._scans, self._scratch_f,
+                self._scratch_i,
+            )
+        finally:
+            numba.set_parallel_chunksize(previous_chunk)
+        if crowd:
+            self._pos, self._vel = out_pos, out_vel
+            self._refill_rand()
+        self._poses = new_p
+        self._wall, self._obstacle, self._agent = wall, obstacle, agent
+        self._twists, self._steer = new_t, new_s
+        self._commands = cmd.copy()
+        if spec.noise_std > 0.0 and due.any():
+            self._noise(due)
         return self._snapshot()
 
     # -- stages (called one by one by benchmarks/batch_step.py for its breakdown) ----------------
@@ -352,7 +400,7 @@ class BatchSim:
         out_vel = np.empty_like(self._vel)
         kernel = K.crowd_worlds if self._parallel(self.num_worlds) else K.crowd_worlds_serial
         kernel(
-            np.ones(self.num_worlds, dtype=bool), self._pos, self._vel, self._heading,
+            self._all, self._pos, self._vel, self._heading,
             self._pradii, self._vmax, self._ped_n, self._wps, self._n_wp, self._wp_mode,
             self._wp_idx, self._rand, self._rand_k,
             self._dist, self._offs, self._shapes, self._res, self._origin,
@@ -360,6 +408,12 @@ class BatchSim:
             self._crowd_prm, float(dt), out_pos, out_vel,
         )
         self._pos, self._vel = out_pos, out_vel
+        self._refill_rand()
+
+    def _refill_rand(self) -> None:
+        """Redraw the random-waypoint uniforms of the worlds that used half of them."""
+        if self._rand_k.max() <= _RAND_TABLE // 2:
+            return
         for i in np.flatnonzero(self._rand_k > _RAND_TABLE // 2):
             rng = self._crowd_rng[i]
             assert rng is not None
@@ -367,6 +421,16 @@ class BatchSim:
             self._rand_k[i] = 0
 
     def _kinematics(self, cmd: F64, dt: float) -> tuple[F64, F64, F64]:
+        if len(self._groups) == 1 and self._groups[0][1].shape[0] == self.num_worlds:
+            # Every world in one group (worlds 0..N-1 in order): no gather and scatter. The
+            # results are copied so the step may write them in place, whatever the model returns.
+            s = self._groups[0][0].step(
+                KinematicState(self._poses, self._twists, self._steer), cmd, dt
+            )
+            return (
+                np.array(s.poses, dtype=np.float64), np.array(s.twists, dtype=np.float64),
+                np.array(s.steering, dtype=np.float64),
+            )
         new_p = np.empty_like(self._poses)
         new_t = np.empty_like(self._twists)
         new_s = np.empty_like(self._steer)
@@ -418,12 +482,17 @@ class BatchSim:
             self._scans, self._scratch_f, self._scratch_i,
         )
         if spec.noise_std > 0.0:
-            for i in np.flatnonzero(due):
-                rng = self._sensor_rng[i]
-                assert rng is not None
-                row = self._scans[i : i + 1]
-                z = rng.standard_normal(row.shape)
-                _add_noise(row, z, spec.noise_std, spec.range_min, spec.range_max)
+            self._noise(due)
+
+    def _noise(self, due: NDArray[np.bool_]) -> None:
+        """Add the sensor noise to the fresh scans of the ``due`` worlds."""
+        spec = self.lidar_spec
+        for i in np.flatnonzero(due):
+            rng = self._sensor_rng[i]
+            assert rng is not None
+            row = self._scans[i : i + 1]
+            z = rng.standard_normal(row.shape)
+            _add_noise(row, z, spec.noise_std, spec.range_min, spec.range_max)
 
     # -- internals -------------------------------------------------------------------------------
     def _parallel(self, worlds: int) -> bool:
