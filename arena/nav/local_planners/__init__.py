@@ -5,6 +5,7 @@ planners arrive through the ``arena.local_planners`` entry-point group.
 """
 
 from arena.nav.local_planners import cohan as _cohan  # noqa: F401  (registers)
+from arena.nav.local_planners import crowdnav as _crowdnav  # noqa: F401  (crowdnav, sarl)
 from arena.nav.local_planners import dwa as _dwa  # noqa: F401  (registers)
 from arena.nav.local_planners import learned as _learned  # noqa: F401  (registers rosnav_rl)
 from arena.nav.local_planners import mpc as _mpc  # noqa: F401  (registers)
