@@ -1,22 +1,35 @@
-r"""Warm-start a PPO run by behaviour cloning a scripted subgoal follower, then train on with PPO.
+r"""Warm-start a PPO run by behaviour cloning a scripted expert, then train on with PPO.
 
-PPO from scratch on ``arena/learn/data/train/rosnav_rl.yaml`` learns slowly: after 385 k steps
-the policy still timed out in 31 of 40 episodes (it learns to avoid collisions by hardly
-moving). A simple expert that turns toward the subgoal and slows down in front of obstacles
-already reaches the goal in 80 % of the batched env's episodes, so the actor starts from it:
+PPO from scratch on Arena's generated indoor maps learns slowly on a few CPU cores (rosnav_rl:
+8 % success after 508 k steps; it learns to avoid collisions by hardly moving). A scripted
+expert already reaches most goals, so the actor starts from it:
 
 1. ``arena train CONFIG -o RUN --steps <one update>`` creates the run folder (run.json, the
-   PPO model, VecNormalize) exactly as ``arena train`` does;
-2. the expert drives the training env (``learning.train.vec_env``) for ``--samples`` steps:
-   the VecNormalize statistics are updated on its observations, and the normalised observations,
-   the expert's actions and the discounted returns are kept;
+   PPO model, VecNormalize) exactly as ``arena train`` does, with the config's vector env
+   (``dummy``, ``subproc``, ``batched`` or ``multi_robot``) and feature extractor;
+2. the expert drives the training env for ``--samples`` steps (all slots together; executed
+   actions get Gaussian noise of std ``--noise``, the labels stay the expert's clean actions,
+   so the data also covers the states just off the expert's path): the VecNormalize statistics
+   are updated on its observations, and the normalised observations, the expert's actions and
+   the discounted returns are kept;
 3. the actor's mean is fitted to the expert's actions (MSE), the log-std set to ``--log-std``,
    and the critic to the returns (MSE), with Adam;
-4. the model and statistics are written as the run's checkpoint, so
-   ``arena train --resume RUN --steps N`` continues with PPO.
+4. ``--dagger-rounds`` times (DAgger, Ross et al. 2011): the fitted policy drives for
+   ``--samples`` more steps while the expert labels the states it visits, and the actor and
+   critic are refitted on everything collected so far;
+5. the model and statistics are written as the run's checkpoint, so
+   ``arena train --resume RUN --steps N`` continues with PPO, and the cloned actor is exported
+   to ``RUN/policy.npz`` as ``arena train`` would (the rlca planner's weights).
 
-    python tools/bc_warmstart.py arena/learn/data/train/rosnav_rl.yaml -o runs/rosnav_rl \\
-        [--samples 200000] [--epochs 8] [--log-std -1.0] [--max-speed 1.0] [--slow-distance 1.0]
+Experts (``--expert``), both reading the raw observation's ``goal`` (a subgoal with
+``observation.subgoal``) and newest ``lidar`` scan:
+
+* ``subgoal``: turn toward the subgoal, slow down in front of obstacles (rosnav_rl's expert);
+* ``gap``: steer along the free corridor (robot-wide) closest to the subgoal's bearing
+  (rlca's expert).
+
+    python tools/bc_warmstart.py arena/learn/data/train/rlca.yaml -o /work/train_runs/rlca \\
+        [--expert gap] [--samples 100000] [--dagger-rounds 1] [--epochs 8] [--log-std -1.0]
 """
 
 from __future__ import annotations
@@ -29,8 +42,13 @@ import argparse
 import json
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+
+
+def _normalised(raw: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    return (2.0 * (raw - low) / (high - low) - 1.0).astype(np.float32)
 
 
 def expert(
@@ -47,15 +65,136 @@ def expert(
     th = obs["goal"][:, 1]
     lid = obs["lidar"][:, -1, :]
     beams = lid.shape[1]
-    c = beams // 2  # the jackal's 720 beams span ±π: beam beams/2 looks straight ahead
+    c = beams // 2  # the jackal's beams are symmetric about straight ahead
     w = max(1, beams // 24)
     front = lid[:, c - w : c + w].min(axis=1)
     v = np.clip(max_speed * np.cos(th), 0.0, max_speed) * np.clip(
         (front - 0.4) / slow_distance, 0.0, 1.0
     )
     om = np.clip(1.5 * th, -1.0, 1.0)
-    raw = np.stack([v, om], axis=1)
-    return (2.0 * (raw - low) / (high - low) - 1.0).astype(np.float32)
+    return _normalised(np.stack([v, om], axis=1), low, high)
+
+
+def gap_expert(
+    obs: dict[str, np.ndarray], low: np.ndarray, high: np.ndarray, angles: np.ndarray,
+    max_speed: float = 1.2, half_width: float = 0.4, look: float = 2.5,
+    slow_distance: float = 1.0, k_turn: float = 2.0, omega_max: float = 1.5,
+) -> np.ndarray:
+    """Normalised ``[v, ω]`` actions of a corridor follower for raw (unnormalised) obs.
+
+    For 41 candidate headings across the laser's field of view, the free length of a corridor
+    ``2·half_width`` m wide (the newest scan's returns inside it, nearest along it); the robot
+    heads for the subgoal when its corridor is free for ``min(ρ, look)`` m, else for the free
+    candidate closest to the subgoal's bearing (none free: the longest). ω = ``k_turn`` · heading
+    (clipped to ``omega_max``), v = ``max_speed`` · cos²(heading), slowed linearly when the
+    corridor straight ahead is shorter than ``0.45 + slow_distance`` m. Angles ``(beams,)`` rad,
+    robot frame. In the rlca training env (3 worlds of 2-4 robots, 600 steps, seed 5) it ended
+    31 episodes at the goal and 2 in collisions (the subgoal follower: 10 and 8 in 300 steps).
+    """
+    rho, th = obs["goal"][:, 0].astype(np.float64), obs["goal"][:, 1].astype(np.float64)
+    step = max(1, angles.size // 180)  # a quarter degree per beam is more than needed
+    a = angles[::step]
+    r = obs["lidar"][:, -1, ::step].astype(np.float64)  # (B, P)
+    cand = np.linspace(a[0] + 0.2, a[-1] - 0.2, 41)  # (K,) rad
+    d = a[None, :] - cand[:, None]  # (K, P)
+    along = r[:, None, :] * np.cos(d)[None]
+    across = np.abs(r[:, None, :] * np.sin(d)[None])
+    free = np.where((across < half_width) & (along > 0), along, np.inf).min(axis=2)  # (B, K)
+    need = np.minimum(rho, look)
+    dev = np.abs(cand[None, :] - th[:, None])
+    score = np.where(free >= need[:, None], dev, 10.0 + look - np.minimum(free, look))
+    heading = cand[np.argmin(score, axis=1)]
+    toward = free[np.arange(th.size), np.argmin(dev, axis=1)]
+    direct = (np.abs(th) < a[-1]) & (toward >= need)
+    heading = np.where(direct, th, heading)
+    om = np.clip(k_turn * heading, -omega_max, omega_max)
+    ahead = free[:, cand.size // 2]
+    v = max_speed * np.clip(np.cos(heading), 0.0, 1.0) ** 2 * np.clip(
+        (ahead - 0.45) / slow_distance, 0.0, 1.0
+    )
+    return _normalised(np.stack([v, om], axis=1), low, high)
+
+
+def _collect(
+    venv: Any, n: int, steps: int, label: Any, drive: Any, noise: float,
+    rng: np.random.Generator, gamma: float,
+) -> tuple[dict[str, np.ndarray], np.ndarray, np.ndarray, tuple[int, int, int]]:
+    """``steps`` steps of all ``n`` slots: raw obs, expert labels, discounted returns.
+
+    ``drive(normalised obs, raw obs)`` picks the executed action (plus noise); ``label(raw obs)``
+    the expert's. Returns the data and (episodes, successes, collisions).
+    """
+    obs = venv.reset()
+    keys = list(obs.keys())
+    buf: dict[str, list[np.ndarray]] = {k: [] for k in keys}
+    acts, rews, dones = [], [], []
+    episodes = successes = collisions = 0
+    for _ in range(steps):
+        raw = venv.get_original_obs()
+        a = label(raw)
+        for k in keys:
+            buf[k].append(raw[k].copy())
+        acts.append(a)
+        run = drive(obs, a)
+        if noise > 0:
+            run = np.clip(run + rng.normal(0.0, noise, run.shape), -1.0, 1.0)
+        obs, _, d, infos = venv.step(run.astype(np.float32))
+        rews.append(venv.get_original_reward())
+        dones.append(d.copy())
+        for i in np.flatnonzero(d):
+            out = infos[i].get("outcome")
+            if out == "cut":  # a multi-robot world restarted under this robot
+                continue
+            episodes += 1
+            successes += out == "success"
+            collisions += out == "collision"
+    rew = np.stack(rews)  # (T, n)
+    don = np.stack(dones)
+    ret = np.zeros_like(rew)
+    acc = np.zeros(n)
+    for t in range(len(rew) - 1, -1, -1):  # discounted returns, cut at episode ends
+        acc = rew[t] + gamma * acc * (1.0 - don[t])
+        ret[t] = acc
+    data = {k: np.concatenate(v) for k, v in buf.items()}
+    return data, np.concatenate(acts), ret.reshape(-1), (episodes, successes, collisions)
+
+
+def _fit(
+    pol: Any, obs: dict[str, np.ndarray], act: np.ndarray, ret: np.ndarray, epochs: int,
+    lr: float, batch: int = 512,
+) -> None:
+    """Fit the actor's mean to ``act`` and the critic to ``ret`` (MSE, Adam)."""
+    import torch
+
+    pol.set_training_mode(True)
+    opt = torch.optim.Adam(pol.parameters(), lr=lr)
+    m = act.shape[0]
+    rng = np.random.default_rng(0)
+    tobs = {k: torch.as_tensor(v) for k, v in obs.items()}
+    tact = torch.as_tensor(act)
+    tret = torch.as_tensor(ret, dtype=torch.float32)
+    for epoch in range(epochs):
+        t0 = time.perf_counter()
+        order = rng.permutation(m)
+        la = lv = 0.0
+        for s in range(0, m, batch):
+            idx = torch.as_tensor(order[s : s + batch])
+            feats = pol.extract_features({k: v[idx] for k, v in tobs.items()})
+            # a tuple when actor and critic have their own extractors
+            pi_f, vf_f = feats if isinstance(feats, tuple) else (feats, feats)
+            mean = pol.action_net(pol.mlp_extractor.forward_actor(pi_f))
+            value = pol.value_net(pol.mlp_extractor.forward_critic(vf_f)).squeeze(-1)
+            loss_a = ((mean - tact[idx]) ** 2).mean()
+            loss_v = ((value - tret[idx]) ** 2).mean()
+            loss = loss_a + 0.01 * loss_v
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            la += float(loss_a.detach()) * len(idx)
+            lv += float(loss_v.detach()) * len(idx)
+        print(f"  epoch {epoch + 1}: action MSE {la / m:.4f}, value MSE {lv / m:.3f} "
+              f"({time.perf_counter() - t0:.0f} s)", flush=True)
+    pol.set_training_mode(False)
 
 
 def main() -> None:
@@ -63,11 +202,17 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("config")
     ap.add_argument("-o", "--out", type=Path, required=True)
-    ap.add_argument("--samples", type=int, default=200_000)
+    ap.add_argument("--expert", choices=["subgoal", "gap"], default="subgoal")
+    ap.add_argument("--samples", type=int, default=200_000, help="steps per collection")
+    ap.add_argument("--dagger-rounds", type=int, default=0)
+    ap.add_argument("--noise", type=float, default=0.0,
+                    help="std of the noise on executed (normalised) actions")
     ap.add_argument("--epochs", type=int, default=8)
     ap.add_argument("--log-std", type=float, default=-1.0)
     ap.add_argument("--lr", type=float, default=1e-3)
-    ap.add_argument("--max-speed", type=float, default=1.0, help="m/s, the expert's top speed")
+    ap.add_argument("--batch", type=int, default=512, help="fit minibatch")
+    ap.add_argument("--max-speed", type=float, default=None,
+                    help="m/s, the expert's top speed (subgoal: 1.0, gap: 1.2)")
     ap.add_argument("--slow-distance", type=float, default=1.0,
                     help="m, the expert slows down over this distance before obstacles")
     args = ap.parse_args()
@@ -77,98 +222,80 @@ def main() -> None:
     from stable_baselines3.common.vec_env import VecNormalize
 
     from arena.learn.actions import ActionDecoder
+    from arena.learn.policy import export_policy, laser_meta
     from arena.learn.train import load_training, make_vec_env, train
     from arena.robots.presets import load_robot
 
+    torch.set_num_threads(int(os.environ.get("OMP_NUM_THREADS", "1")))
     cfg, settings = load_training(args.config)
     tr, ppo = settings.train, settings.ppo
-    one_update = ppo.batch_size
-    t0 = time.perf_counter()
+    t_start = time.perf_counter()
     first = settings.model_copy(
-        update={"train": tr.model_copy(update={"total_steps": one_update})}
+        update={"train": tr.model_copy(update={"total_steps": ppo.batch_size})}
     )
     train(cfg, first, args.out, progress=False)
     run = json.loads((args.out / "run.json").read_text())
     ckpt = args.out / run["checkpoint"]
-    print(f"run created ({time.perf_counter() - t0:.0f} s): {ckpt}")
+    print(f"run created ({time.perf_counter() - t_start:.0f} s): {ckpt}", flush=True)
 
-    dec = ActionDecoder(cfg.learning.env.action, load_robot(cfg.robot))
+    robot = load_robot(cfg.robot)
+    dec = ActionDecoder(cfg.learning.env.action, robot)
     low, high = dec.range_low[:2], dec.range_high[:2]
-    venv = make_vec_env(cfg, tr.n_envs, tr.vec_env, seed=int(run["seed"]) + 7919)
+    angles = np.asarray(laser_meta(robot.laser)["angles"])
+
+    def label(raw: dict[str, np.ndarray]) -> np.ndarray:
+        if args.expert == "gap":
+            return gap_expert(raw, low, high, angles,
+                              max_speed=args.max_speed or 1.2, slow_distance=args.slow_distance)
+        return expert(raw, low, high, args.max_speed or 1.0, args.slow_distance)
+
+    venv = make_vec_env(cfg, tr.n_envs, tr.vec_env, seed=int(run["seed"]) + 7919,
+                        robots_per_world=tr.robots_per_world)
     venv = VecNormalize.load(str(ckpt / "vecnormalize.pkl"), venv)
     venv.training = True
     model = PPO.load(ckpt / "model.zip", env=venv, device="cpu")
-
-    # -- collect --------------------------------------------------------------------------
-    n = tr.n_envs
-    obs = venv.reset()
-    keys = list(obs.keys())
-    buf_obs: dict[str, list[np.ndarray]] = {k: [] for k in keys}
-    acts, rews, dones = [], [], []
-    steps = args.samples // n
-    t0 = time.perf_counter()
-    successes = episodes = 0
-    for _ in range(steps):
-        raw = venv.get_original_obs()
-        a = expert(raw, low, high, args.max_speed, args.slow_distance)
-        for k in keys:
-            buf_obs[k].append(obs[k].copy())
-        acts.append(a)
-        obs, _, d, infos = venv.step(a)
-        rews.append(venv.get_original_reward())
-        dones.append(d.copy())
-        for i in np.flatnonzero(d):
-            episodes += 1
-            successes += bool(infos[i].get("is_success"))
-    print(f"expert: {steps * n} samples in {time.perf_counter() - t0:.0f} s, "
-          f"{successes}/{episodes} episodes reached the goal")
-    obs_t = {k: np.concatenate(v) for k, v in buf_obs.items()}
-    act_t = np.concatenate(acts)
-    rew = np.stack(rews)  # (T, n)
-    don = np.stack(dones)
-    ret = np.zeros_like(rew)
-    acc = np.zeros(n)
-    for t in range(len(rew) - 1, -1, -1):  # discounted returns, cut at episode ends
-        acc = rew[t] + ppo.gamma * acc * (1.0 - don[t])
-        ret[t] = acc
-    ret_t = ret.reshape(-1)
-
-    # -- fit ------------------------------------------------------------------------------
     pol = model.policy
-    pol.set_training_mode(True)
-    opt = torch.optim.Adam(pol.parameters(), lr=args.lr)
-    m = act_t.shape[0]
-    rng = np.random.default_rng(0)
-    tobs = {k: torch.as_tensor(v) for k, v in obs_t.items()}
-    tact = torch.as_tensor(act_t)
-    tret = torch.as_tensor(ret_t, dtype=torch.float32)
-    for epoch in range(args.epochs):
-        order = rng.permutation(m)
-        la = lv = 0.0
-        for s in range(0, m, 1024):
-            idx = torch.as_tensor(order[s : s + 1024])
-            batch = {k: v[idx] for k, v in tobs.items()}
-            feats = pol.extract_features(batch, pol.pi_features_extractor)
-            lat_pi, lat_vf = pol.mlp_extractor(feats)
-            mean = pol.action_net(lat_pi)
-            value = pol.value_net(lat_vf).squeeze(-1)
-            loss_a = ((mean - tact[idx]) ** 2).mean()
-            loss_v = ((value - tret[idx]) ** 2).mean()
-            loss = loss_a + 0.01 * loss_v
-            opt.zero_grad()
-            loss.backward()
-            opt.step()
-            la += float(loss_a) * len(idx)
-            lv += float(loss_v) * len(idx)
-        print(f"epoch {epoch + 1}: action MSE {la / m:.4f}, value MSE {lv / m:.3f}")
+    rng = np.random.default_rng(1)
+    n = tr.n_envs
+    data: list[tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]] = []
+    for rnd in range(args.dagger_rounds + 1):
+        t0 = time.perf_counter()
+        if rnd == 0:
+            def drive(obs: Any, expert_action: np.ndarray) -> np.ndarray:
+                return expert_action
+        else:
+            venv.training = False  # the statistics the policy was fitted with stay fixed
+
+            def drive(obs: Any, expert_action: np.ndarray) -> np.ndarray:
+                act, _ = model.predict(obs, deterministic=True)
+                return np.asarray(act, np.float32)
+        obs_r, act_r, ret_r, (eps, succ, coll) = _collect(
+            venv, n, args.samples // n, label, drive, args.noise, rng, ppo.gamma
+        )
+        who = "expert" if rnd == 0 else f"policy (DAgger round {rnd})"
+        print(f"{who}: {act_r.shape[0]} samples in {time.perf_counter() - t0:.0f} s, "
+              f"{eps} episodes: {succ} at the goal, {coll} collisions", flush=True)
+        data.append((obs_r, act_r, ret_r))
+        # raw observations normalised with the statistics as they are now (round 0's moved
+        # while it collected), so that every sample sees the normalisation the policy will use
+        obs_t = venv.normalize_obs({k: np.concatenate([d[0][k] for d in data]) for k in obs_r})
+        obs_t = {k: np.asarray(v, np.float32) for k, v in obs_t.items()}
+        act_t = np.concatenate([d[1] for d in data])
+        ret_t = np.concatenate([d[2] for d in data])
+        t0 = time.perf_counter()
+        _fit(pol, obs_t, act_t, ret_t, args.epochs, args.lr, args.batch)
+        print(f"fit on {act_t.shape[0]} samples: {time.perf_counter() - t0:.0f} s", flush=True)
     with torch.no_grad():
         pol.log_std.fill_(args.log_std)
-    pol.set_training_mode(False)
     model.save(ckpt / "model.zip")
     venv.save(str(ckpt / "vecnormalize.pkl"))
+    export_policy(
+        model, venv if ppo.normalize.norm_obs else None, args.out / "policy.npz", decoder=dec,
+        observation=cfg.learning.env.observation.model_dump(mode="json"), laser=robot.laser,
+    )
     venv.close()
-    print(f"warm start written to {ckpt}; continue with: arena train --resume {args.out} "
-          "--steps N")
+    print(f"warm start written to {ckpt} ({time.perf_counter() - t_start:.0f} s in all); "
+          f"continue with: arena train --resume {args.out} --steps N", flush=True)
 
 
 if __name__ == "__main__":

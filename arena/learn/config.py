@@ -8,6 +8,7 @@ One experiment YAML drives both ``arena run`` and :class:`~arena.learn.env.Socia
           lidar: true
           goal: true
           last_action: true
+          velocity: false              # measured body twist [vx, vy, ω]
           laser_stack: 1
           pedestrians: {enabled: true, k: 5, max_range: 8.0}
           semantic: {enabled: false, size: 80, roi: 20.0, channels: [pedestrian_location]}
@@ -91,6 +92,9 @@ class ObservationConfig(_Strict):
     lidar: bool = Field(True, description="'lidar': (laser_stack, beams) ranges in m")
     goal: bool = Field(True, description="'goal': [ρ m, θ rad] in the robot frame")
     last_action: bool = Field(True, description="'last_action': [vx, vy, ω] last command")
+    velocity: bool = Field(
+        False, description="'velocity': [vx, vy, ω] measured body twist (vy = 0 for diff drive)"
+    )
     laser_stack: int = Field(1, ge=1, description="number of most recent scans stacked")
     goal_max_distance: float = Field(
         30.0, gt=0, description="m; ρ is clipped to this (Arena's GOAL space: [0, 30])"
@@ -126,7 +130,8 @@ class EnvConfig(_Strict):
     action: ActionConfig = Field(default_factory=ActionConfig)
     reward: RewardSpec = Field(
         "default",
-        description="packaged reward file (default, base_semantic, rule_13) or {term: {params}}",
+        description="packaged reward file (default, base_semantic, rule_13, rlca) "
+        "or {term: {params}}",
     )
     action_period: float | None = Field(
         None, gt=0, description="s per env step, a multiple of sim.dt; null = sim.dt"

@@ -9,6 +9,12 @@ them with a leading ``N`` axis):
                                        ρ clipped to ``goal_max_distance``
                                        (Arena offsets θ by π, §10.9; we do not)
 ``last_action``    ``(3,)``            last command ``[vx m/s, vy m/s, ω rad/s]``
+``velocity``       ``(3,)``            measured body twist ``[vx m/s, vy m/s, ω rad/s]`` (what
+                                       the simulator executed, after acceleration limits and
+                                       contacts; Long et al.'s ``v_t``). Always three
+                                       components, the layout of ``last_action``, so that one
+                                       policy layout serves every drive: ``vy`` reads 0 for
+                                       non-holonomic robots. Clipped to the command box.
 ``pedestrians``    ``(k, 6)``          k nearest people within ``max_range``, nearest first:
                                        ``[x m, y m, vx m/s, vy m/s, type, social_state]`` with
                                        position and velocity relative to the robot, in its
@@ -124,6 +130,11 @@ class ObservationBuilder:
             lo = np.array([lim.vx_min, vy[0], -lim.omega_max], np.float32)
             hi = np.array([lim.vx_max, vy[1], lim.omega_max], np.float32)
             parts["last_action"] = spaces.Box(np.minimum(lo, 0), np.maximum(hi, 0))
+        if config.velocity:
+            vy = (lim.vy_min, lim.vy_max) if lim.vy_max > lim.vy_min else (lim.vx_min, lim.vx_max)
+            lo = np.array([lim.vx_min, vy[0], -lim.omega_max], np.float32)
+            hi = np.array([lim.vx_max, vy[1], lim.omega_max], np.float32)
+            parts["velocity"] = spaces.Box(np.minimum(lo, 0), np.maximum(hi, 0))
         pc = config.pedestrians
         if pc.enabled:
             r, v = pc.max_range, MAX_SPEED
@@ -159,6 +170,10 @@ class ObservationBuilder:
         self._action_bounds: tuple[FloatArray, FloatArray] | None = (
             (la.low.astype(np.float64), la.high.astype(np.float64)) if la is not None else None
         )
+        ve = parts.get("velocity")
+        self._velocity_bounds: tuple[FloatArray, FloatArray] | None = (
+            (ve.low.astype(np.float64), ve.high.astype(np.float64)) if ve is not None else None
+        )
         self.space: spaces.Space[object] = (
             spaces.flatten_space(self.dict_space) if config.flatten else self.dict_space
         )
@@ -178,6 +193,10 @@ class ObservationBuilder:
             assert self._action_bounds is not None
             lo, hi = self._action_bounds
             out["last_action"] = np.clip(inp.last_action, lo, hi).astype(np.float32)
+        if "velocity" in self.keys:
+            assert self._velocity_bounds is not None
+            lo, hi = self._velocity_bounds
+            out["velocity"] = np.clip(inp.twists, lo, hi).astype(np.float32)
         if cfg.pedestrians.enabled or cfg.semantic.enabled:
             rel = to_robot_frame(inp.ped_pos - inp.poses[:, None, :2], inp.poses[:, 2])
             if cfg.pedestrians.enabled:

@@ -14,6 +14,9 @@
 ``command_table``             ``(k, 3)`` ``[vx, vy, ω]`` of each discrete action (optional)
 ``command_low/high``,         continuous decoding (optional): raw ranges, clip box
 ``range_low/high``
+``fx/conv{i}/w``, ``/b``      format 2 only: Conv1d layers of the ``rlca_conv`` extractor,
+                              ``w`` ``(out, in, kernel)`` (torch's layout), ReLU after each
+``fx/fc/w``, ``fx/fc/b``      format 2 only: its fully connected layer (ReLU)
 ``meta``                      JSON: activation, observation keys / shapes / flatten order,
                               normalisation clip and epsilon, action type, command decoding,
                               the ``learning.env.observation`` block, and ``laser``:
@@ -22,9 +25,17 @@
 ============================ ===============================================================
 
 The flatten order is SB3's: each key's array flattened in C order (``nn.Flatten``), keys in the
-order of the extractor's ``ModuleDict`` (the Dict space's order). :class:`NumpyPolicy` imports
-no torch: ``act`` reproduces ``model.predict(obs, deterministic=True)`` (argmax of the logits,
-or the Gaussian mean clipped to the action box).
+order of the extractor's ``ModuleDict`` (the Dict space's order).
+
+Format 2 (written only for policies with the ``rlca_conv`` extractor,
+:class:`~arena.learn.extractors.RLCAConvExtractor`; MLP policies stay format 1, so readers of
+format 1 keep reading them) adds ``meta["extractor"]`` = ``{"type": "rlca_conv", "scan_key",
+"strides": [...], "other_keys": [...]}``: the features are the scan through the convs and the
+FC layer, then the ``other_keys`` parts flattened, and the MLP above runs on them.
+
+:class:`NumpyPolicy` imports no torch: ``act`` reproduces
+``model.predict(obs, deterministic=True)`` (argmax of the logits, or the Gaussian mean clipped to
+the action box).
 """
 
 from __future__ import annotations
@@ -41,7 +52,10 @@ from numpy.typing import ArrayLike, NDArray
 from arena.core.errors import ConfigError
 
 FORMAT = 1
-"""Version of the ``.npz`` layout."""
+"""Version of the ``.npz`` layout of MLP policies."""
+FORMAT_CONV = 2
+"""Version of the layout with a conv feature extractor (a superset of format 1)."""
+_FORMATS = (FORMAT, FORMAT_CONV)
 _ACTIVATIONS = {"ReLU": "relu", "Tanh": "tanh", "Identity": "identity"}
 _FLAT_KEY = "obs"
 
@@ -99,13 +113,35 @@ def export_policy(
     )
     from stable_baselines3.common.torch_layers import CombinedExtractor, FlattenExtractor
 
+    from arena.learn.extractors import RLCAConvExtractor
+
     policy = model.policy
     if getattr(policy, "squash_output", False):
         raise ValueError("policies with squashed outputs (gSDE) cannot be exported")
     arrays: dict[str, NDArray[Any]] = {}
     obs_space = policy.observation_space
     extractor = policy.pi_features_extractor
-    if isinstance(extractor, CombinedExtractor):
+    fx_meta: dict[str, Any] | None = None
+    if isinstance(extractor, RLCAConvExtractor):
+        keys = list(obs_space.spaces.keys())
+        sub_spaces = {k: obs_space[k] for k in keys}
+        obs_type = "dict"
+        import torch.nn as nn
+
+        convs = [m for m in extractor.convs if isinstance(m, nn.Conv1d)]
+        for i, conv in enumerate(convs):
+            arrays[f"fx/conv{i}/w"] = _np(conv.weight)
+            arrays[f"fx/conv{i}/b"] = _np(conv.bias)
+        fc = extractor.fc[1]
+        arrays["fx/fc/w"] = _np(fc.weight)
+        arrays["fx/fc/b"] = _np(fc.bias)
+        fx_meta = {
+            "type": "rlca_conv",
+            "scan_key": extractor.scan_key,
+            "strides": [int(c.stride[0]) for c in convs],
+            "other_keys": list(extractor.other_keys),
+        }
+    elif isinstance(extractor, CombinedExtractor):
         import torch.nn as nn
 
         keys = list(extractor.extractors.keys())
@@ -176,7 +212,7 @@ def export_policy(
             }
 
     meta = {
-        "format": FORMAT,
+        "format": FORMAT if fx_meta is None else FORMAT_CONV,
         "activation": act,
         "n_layers": len(layers),
         "obs": {
@@ -190,6 +226,8 @@ def export_policy(
         "observation": dict(observation) if observation is not None else None,
         "laser": laser_meta(laser) if laser is not None else None,
     }
+    if fx_meta is not None:
+        meta["extractor"] = fx_meta
     return _write(path, arrays, meta)
 
 
@@ -308,6 +346,26 @@ def write_random_policy(
     return _write(path, arrays, pol.meta)
 
 
+def conv1d(
+    x: NDArray[np.float64], w: NDArray[np.float64], b: NDArray[np.float64], stride: int
+) -> NDArray[np.float64]:
+    """Torch's ``Conv1d`` (no padding, no dilation) in numpy.
+
+    Args:
+        x: ``(B, C, L)`` input.
+        w: ``(O, C, K)`` weights.
+        b: ``(O,)`` bias.
+        stride: step between windows.
+
+    Returns:
+        ``(B, O, (L − K) // stride + 1)``.
+    """
+    k = w.shape[2]
+    win = np.lib.stride_tricks.sliding_window_view(x, k, axis=2)[:, :, ::stride, :]
+    out = np.einsum("bclk,ock->bol", win, w, optimize=True) + b[None, :, None]
+    return np.asarray(out, dtype=np.float64)
+
+
 class NumpyPolicy:
     """A policy written by :func:`export_policy`, evaluated with numpy.
 
@@ -322,9 +380,10 @@ class NumpyPolicy:
             self.meta: dict[str, Any] = json.loads(str(arrays["meta"]))
         except KeyError:
             raise ConfigError("not an exported policy (no 'meta' entry)", source=source) from None
-        if self.meta.get("format") != FORMAT:
+        if self.meta.get("format") not in _FORMATS:
             raise ConfigError(
-                f"policy format {self.meta.get('format')!r} is not supported (expected {FORMAT})",
+                f"policy format {self.meta.get('format')!r} is not supported "
+                f"(expected one of {list(_FORMATS)})",
                 source=source,
             )
         self.source = source
@@ -341,6 +400,21 @@ class NumpyPolicy:
         self._clip = float(norm.get("clip", np.inf))
         self._eps = float(norm.get("epsilon", 0.0))
         self.discrete = self.meta["action"]["type"] == "discrete"
+        self.extractor: dict[str, Any] | None = self.meta.get("extractor")
+        if self.extractor is not None:
+            if self.extractor.get("type") != "rlca_conv" or not self.is_dict:
+                raise ConfigError(
+                    f"unknown feature extractor {self.extractor.get('type')!r}", source=source
+                )
+            n_conv = len(self.extractor["strides"])
+            self._conv = [
+                (self.arrays[f"fx/conv{i}/w"].astype(np.float64),
+                 self.arrays[f"fx/conv{i}/b"].astype(np.float64),
+                 int(self.extractor["strides"][i]))
+                for i in range(n_conv)
+            ]
+            self._fc = (self.arrays["fx/fc/w"].astype(np.float64),
+                        self.arrays["fx/fc/b"].astype(np.float64))
 
     @classmethod
     def load(cls, path: str | Path) -> NumpyPolicy:
@@ -381,10 +455,10 @@ class NumpyPolicy:
             out[k] = a
         return out, single
 
-    def features(self, obs: Any) -> NDArray[np.float64]:
-        """``(B, D)`` normalised, flattened observation (as the SB3 network receives it)."""
+    def normalised(self, obs: Any) -> dict[str, NDArray[np.float64]]:
+        """Per key ``(B, *shape)``: the observation after VecNormalize (float32 precision)."""
         parts, _ = self._batched(obs)
-        flat = []
+        out = {}
         for k in self.keys:
             a = parts[k]
             if k in self._norm_keys:
@@ -392,8 +466,24 @@ class NumpyPolicy:
                     (a - self.arrays[f"mean/{k}"]) / np.sqrt(self.arrays[f"var/{k}"] + self._eps),
                     -self._clip, self._clip,
                 )
-            flat.append(a.astype(np.float32).reshape(a.shape[0], -1))
-        return np.concatenate(flat, axis=1).astype(np.float64)
+            # SB3 feeds float32 tensors; rounding here keeps the numpy path on the same inputs
+            out[k] = a.astype(np.float32).astype(np.float64)
+        return out
+
+    def features(self, obs: Any) -> NDArray[np.float64]:
+        """``(B, D)`` input of the policy MLP: the flattened observation, or the conv features."""
+        parts = self.normalised(obs)
+        if self.extractor is None:
+            return np.concatenate(
+                [parts[k].reshape(parts[k].shape[0], -1) for k in self.keys], axis=1
+            )
+        x = parts[self.extractor["scan_key"]]  # (B, stack, beams): channels × length
+        for w, b, stride in self._conv:
+            x = np.maximum(conv1d(x, w, b, stride), 0.0)
+        w_fc, b_fc = self._fc
+        scan = np.maximum(x.reshape(x.shape[0], -1) @ w_fc.T + b_fc, 0.0)
+        rest = [parts[k].reshape(parts[k].shape[0], -1) for k in self.extractor["other_keys"]]
+        return np.concatenate([scan, *rest], axis=1)
 
     def logits(self, obs: Any) -> NDArray[np.float64]:
         """``(B, A)`` action logits (discrete) or Gaussian means (continuous), unclipped."""

@@ -419,6 +419,30 @@ class AngularVelConstraintTerm:
         return _result(np.where(w > p.threshold, -p.penalty_factor * w, 0.0))
 
 
+@REWARD_TERMS.register("rotation_penalty")
+class RotationPenaltyTerm:
+    """``−factor · |ω|`` when the commanded yaw rate ``|ω|`` exceeds ``threshold`` (Long et al.).
+
+    Long et al. 2018 (eq. 5, ``r_w``) penalise large rotational *commands*, not the measured
+    heading change of :class:`AngularVelConstraintTerm`: a robot pinned against a wall still
+    pays for asking to spin, and the term needs no estimate from poses.
+    """
+
+    class Params(_Params):
+        """Parameters, with Long et al.'s values."""
+
+        factor: float = Field(0.1, ge=0, description="per rad/s of commanded |ω|")
+        threshold: float = Field(0.7, ge=0, description="rad/s; smaller |ω| is free")
+
+    def __init__(self, params: Params) -> None:
+        self.params = params
+
+    def __call__(self, inp: RewardInput) -> TermResult:
+        """Rewards ``(N,)`` for the ``N`` worlds of ``inp``."""
+        w = np.abs(inp.action[:, 2])
+        return _result(np.where(w > self.params.threshold, -self.params.factor * w, 0.0))
+
+
 @REWARD_TERMS.register("max_steps_exceeded")
 class MaxStepsExceededTerm:
     """``+reward`` and done (step limit) when the step count reaches ``max_steps``."""

@@ -10,9 +10,13 @@
     RUN/policy.npz                   the final actor for numpy inference (arena.learn.policy)
 
 Training uses ``n_envs`` :class:`~arena.learn.env.SocialNavEnv` instances seeded ``seed + k``
-(``DummyVecEnv`` or ``SubprocVecEnv``) under SB3's ``VecNormalize`` (observations normalised,
+(``DummyVecEnv`` or ``SubprocVecEnv``; ``batched``: one batched simulator; ``multi_robot``:
+:class:`~arena.learn.multi_vec.MultiRobotVecEnv`, one slot per robot of ``robots_per_world``
+worlds, so several robots share one world and the policy's parameters) under SB3's
+``VecNormalize`` (observations normalised,
 rewards not, clip 30; Arena's setting). ``MultiInputPolicy`` serves Dict observations,
-``MlpPolicy`` flat ones.
+``MlpPolicy`` flat ones; ``learning.ppo.extractor`` picks the feature extractor
+(:mod:`arena.learn.extractors`, e.g. Long et al.'s ``rlca_conv`` scan encoder).
 
 Curriculum: when ``task.modules`` has a ``staged`` module, a separate evaluation env runs
 ``eval.episodes`` deterministic episodes every ``eval.every`` env steps; the module's
@@ -119,6 +123,18 @@ def _first_difference(a: Any, b: Any, prefix: str = "") -> str | None:
     return None if a == b else prefix
 
 
+def _current(schema: Any, stored: Any) -> Any:
+    """A stored config re-read through today's ``schema``, or as stored if it no longer validates.
+
+    Fields added since get their defaults, so a run made before a new option existed still
+    resumes; an invalid one is compared as stored (the comparison names the first difference).
+    """
+    try:
+        return json.loads(json.dumps(schema.model_validate(stored).model_dump(mode="json")))
+    except ValueError:
+        return json.loads(json.dumps(stored))
+
+
 def check_resume(run_dir: Path, cfg: ExperimentConfig, settings: TrainSettings) -> dict[str, Any]:
     """The run's manifest, if ``cfg``/``settings`` match it (``total_steps`` may differ).
 
@@ -127,11 +143,11 @@ def check_resume(run_dir: Path, cfg: ExperimentConfig, settings: TrainSettings) 
     """
     data = read_run(run_dir)
     want_settings = settings.model_dump(mode="json")
-    have_settings = json.loads(json.dumps(data["settings"]))
+    have_settings = _current(TrainSettings, data["settings"])
     want_settings["train"].pop("total_steps")
     have_settings["train"].pop("total_steps", None)
     for what, have, want in (
-        ("config", data["config"], cfg.model_dump(mode="json")),
+        ("config", _current(ExperimentConfig, data["config"]), cfg.model_dump(mode="json")),
         ("settings", have_settings, want_settings),
     ):
         diff = _first_difference(have, json.loads(json.dumps(want)))
@@ -216,14 +232,29 @@ def make_vec_env(
     kind: str = "dummy",
     robot: RobotModel | None = None,
     seed: int | None = None,
+    robots_per_world: Sequence[int] | None = None,
 ) -> Any:
     """``n_envs`` environments in SB3's ``DummyVecEnv`` or ``SubprocVecEnv``.
 
     ``kind="batched"``: one :class:`~arena.learn.batched.SB3VecEnv` over a
     :class:`~arena.learn.batched.BatchedSocialNavEnv` of ``n_envs`` worlds (seeded with
-    ``seed`` at its next reset when given).
+    ``seed`` at its next reset when given). ``kind="multi_robot"``: a
+    :class:`~arena.learn.multi_vec.MultiRobotVecEnv` with ``robots_per_world`` (summing to
+    ``n_envs``; default: one world of ``n_envs`` robots).
     """
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    if kind == "multi_robot":
+        from arena.learn.multi_vec import MultiRobotVecEnv
+
+        rpw = list(robots_per_world) if robots_per_world is not None else [n_envs]
+        if sum(rpw) != n_envs:
+            raise ConfigError(f"robots_per_world {rpw} does not sum to n_envs {n_envs}",
+                              path="learning.train.robots_per_world")
+        mvenv = MultiRobotVecEnv(cfg, rpw, robot=robot)
+        if seed is not None:
+            mvenv.seed(int(seed))
+        return mvenv
 
     if kind == "batched":
         from arena.learn.batched import SB3VecEnv
@@ -499,6 +530,7 @@ def train(
     from stable_baselines3.common.vec_env import VecNormalize
 
     from arena.learn.actions import ActionDecoder
+    from arena.learn.extractors import policy_kwargs_for
     from arena.learn.policy import export_policy
     from arena.robots.presets import load_robot
     from arena.tasks.base import build_mode
@@ -535,7 +567,8 @@ def train(
     if staged is not None and manifest.get("stage") is not None:
         staged.set_stage(int(manifest["stage"]))
 
-    venv = make_vec_env(cfg, tr.n_envs, tr.vec_env, robot, seed=seed)
+    venv = make_vec_env(cfg, tr.n_envs, tr.vec_env, robot, seed=seed,
+                        robots_per_world=tr.robots_per_world)
     nc = ppo.normalize
     try:
         if resume:
@@ -567,6 +600,8 @@ def train(
                 policy_kwargs={
                     "net_arch": {"pi": list(ppo.net_arch.pi), "vf": list(ppo.net_arch.vf)},
                     "activation_fn": {"relu": nn.ReLU, "tanh": nn.Tanh}[ppo.activation],
+                    "share_features_extractor": ppo.share_features_extractor,
+                    **policy_kwargs_for(ppo.extractor),
                 },
                 tensorboard_log=str(run / "tb") if tr.tensorboard else None,
                 seed=seed, device=tr.device, verbose=0,

@@ -18,11 +18,14 @@ training config (arena_specs §8.5; the June 2024 values where March and June di
         max_grad_norm: 0.5
         net_arch: {pi: [64, 64], vf: [64, 64]}
         activation: relu
+        extractor: {type: flatten}          # or {type: rlca_conv, filters: [32, 32], ...}
+        share_features_extractor: true
         normalize: {norm_obs: true, norm_reward: false, clip_obs: 30.0, clip_reward: 20.0}
       train:
         total_steps: 4000000
         n_envs: 4
-        vec_env: subproc
+        vec_env: subproc           # dummy | subproc | batched | multi_robot
+        robots_per_world: null     # multi_robot: robots of each world, summing to n_envs
         checkpoint_every: 100000
         eval: {episodes: 40, every: 20000}
         curriculum: {enabled: true, stop_success: 0.98}
@@ -30,7 +33,7 @@ training config (arena_specs §8.5; the June 2024 values where March and June di
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -60,6 +63,43 @@ class NetArch(_Strict):
         return self
 
 
+class FlattenExtractorConfig(_Strict):
+    """SB3's default: every observation part flattened and concatenated (an MLP policy)."""
+
+    type: Literal["flatten"] = "flatten"
+
+
+class RLCAConvExtractorConfig(_Strict):
+    """Long et al. 2018's scan encoder (:class:`arena.learn.extractors.RLCAConvExtractor`).
+
+    The ``scan_key`` part ``(stack, beams)`` goes through ``Conv1d`` layers (the stack as input
+    channels, ReLU after each) and one fully connected layer (ReLU); the other parts are
+    flattened and appended, in the observation's key order. Defaults are the paper's: 32
+    filters of kernel 5 stride 2, 32 of kernel 3 stride 2, FC 256.
+    """
+
+    type: Literal["rlca_conv"] = "rlca_conv"
+    scan_key: str = Field("lidar", description="the (stack, beams) observation part")
+    filters: list[int] = Field([32, 32], min_length=1, description="output channels per conv")
+    kernels: list[int] = Field([5, 3], min_length=1, description="kernel size per conv (beams)")
+    strides: list[int] = Field([2, 2], min_length=1, description="stride per conv (beams)")
+    fc: int = Field(256, ge=1, description="width of the fully connected layer after the convs")
+
+    @model_validator(mode="after")
+    def _layers(self) -> RLCAConvExtractorConfig:
+        if not len(self.filters) == len(self.kernels) == len(self.strides):
+            raise ValueError("filters, kernels and strides must have one entry per conv layer")
+        if any(v < 1 for v in (*self.filters, *self.kernels, *self.strides)):
+            raise ValueError("filters, kernels and strides must be >= 1")
+        return self
+
+
+ExtractorConfig = Annotated[
+    FlattenExtractorConfig | RLCAConvExtractorConfig, Field(discriminator="type")
+]
+"""The policy's feature extractor, picked by ``type``."""
+
+
 class NormalizeConfig(_Strict):
     """SB3 ``VecNormalize`` (arena_specs §8.2: obs normalised, rewards not, clip 30)."""
 
@@ -87,6 +127,13 @@ class PPOConfig(_Strict):
     max_grad_norm: float = Field(0.5, gt=0, description="gradient clipping")
     net_arch: NetArch = Field(default_factory=NetArch)
     activation: Literal["relu", "tanh"] = Field("relu", description="hidden-layer activation")
+    extractor: ExtractorConfig = Field(
+        default_factory=FlattenExtractorConfig,
+        description="feature extractor before the MLPs: flatten (default) or rlca_conv",
+    )
+    share_features_extractor: bool = Field(
+        True, description="actor and critic share the extractor (false: one each, Long et al.)"
+    )
     normalize: NormalizeConfig = Field(default_factory=NormalizeConfig)
 
 
@@ -114,10 +161,15 @@ class TrainConfig(_Strict):
 
     total_steps: int = Field(4_000_000, ge=1, description="env steps (Arena Jun 2024: 4e6)")
     n_envs: int = Field(4, ge=1, description="parallel training envs (Arena Jun 2024: 4)")
-    vec_env: Literal["dummy", "subproc", "batched"] = Field(
+    vec_env: Literal["dummy", "subproc", "batched", "multi_robot"] = Field(
         "subproc",
         description="SB3 vector env; one env always runs in-process; batched: "
-        "BatchedSocialNavEnv (all envs in one BatchSim; evaluation stays on SocialNavEnv)",
+        "BatchedSocialNavEnv (all envs in one BatchSim; evaluation stays on SocialNavEnv); "
+        "multi_robot: MultiRobotVecEnv, one slot per robot of robots_per_world worlds",
+    )
+    robots_per_world: list[int] | None = Field(
+        None,
+        description="multi_robot: robots in each world (one entry per world), summing to n_envs",
     )
     seed: int | None = Field(None, ge=0, description="run seed; null: the experiment's seed")
     checkpoint_every: int = Field(100_000, ge=1, description="env steps between checkpoints")
@@ -125,6 +177,23 @@ class TrainConfig(_Strict):
     device: Literal["auto", "cpu", "cuda"] = Field("cpu", description="torch device")
     eval: EvalConfig = Field(default_factory=EvalConfig)
     curriculum: CurriculumTrainConfig = Field(default_factory=CurriculumTrainConfig)
+
+    @model_validator(mode="after")
+    def _robots(self) -> TrainConfig:
+        rpw = self.robots_per_world
+        if self.vec_env == "multi_robot":
+            if rpw is None:
+                raise ValueError("vec_env multi_robot needs robots_per_world, e.g. [2, 3, 4]")
+            if any(r < 1 for r in rpw) or not rpw:
+                raise ValueError("robots_per_world entries must be >= 1")
+            if sum(rpw) != self.n_envs:
+                raise ValueError(
+                    f"robots_per_world {rpw} has {sum(rpw)} robots; n_envs is {self.n_envs} "
+                    "(one PPO slot per robot)"
+                )
+        elif rpw is not None:
+            raise ValueError("robots_per_world only applies to vec_env multi_robot")
+        return self
 
 
 class TrainSettings(_Strict):

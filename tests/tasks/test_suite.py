@@ -1,7 +1,10 @@
 """Benchmark suites: loading Arena's files, stage experiments, determinism, errors."""
 
+from pathlib import Path
+
 import pytest
 
+import arena
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError
 from arena.robots.presets import load_robot
@@ -214,3 +217,23 @@ def test_contestant_planner_params(tmp_path):
     with pytest.raises(ConfigError, match=r"params\.max_sped: unknown key") as e:
         contestant_config(ExperimentConfig(), load_contest(bad)[0].contestants[0], source=str(bad))
     assert e.value.path == "contestants[0].params.max_sped"
+
+
+@pytest.mark.parametrize(
+    "name",
+    sorted(p.stem for p in (Path(arena.__file__).parent / "tasks" / "data" / "contests").glob(
+        "*.yaml")),
+)
+def test_every_packaged_contest_builds_its_planners(name):
+    """Each packaged contest names registered planners whose (packaged) weights load."""
+    from arena.nav.local_planners.base import LOCAL_PLANNERS
+    from arena.tasks.suite import contestant_config
+
+    contest, source = load_contest(name)
+    for i, c in enumerate(contest.contestants):
+        cfg = contestant_config(ExperimentConfig(), c, source=source, index=i)
+        planner = LOCAL_PLANNERS.build(cfg.navigation.local_planner)
+        assert hasattr(planner, "compute")
+    if name == "learned":
+        assert {c.local_planner for c in contest.contestants} >= {
+            "dwa", "rosnav_rl", "rlca", "crowdnav", "sarl"}

@@ -11,6 +11,7 @@ from arena.nav.local_planners import learned as _learned  # noqa: F401  (registe
 from arena.nav.local_planners import mpc as _mpc  # noqa: F401  (registers)
 from arena.nav.local_planners import orca_planner as _orca_planner  # noqa: F401  (registers)
 from arena.nav.local_planners import pure_pursuit as _pure_pursuit  # noqa: F401  (registers)
+from arena.nav.local_planners import rlca as _rlca  # noqa: F401  (registers rlca)
 from arena.nav.local_planners import social_force as _social_force  # noqa: F401  (registers)
 from arena.nav.local_planners import teb as _teb  # noqa: F401  (registers)
 from arena.nav.local_planners.base import (

@@ -17,6 +17,10 @@ Description:
     Policies whose observation has ``pedestrians`` or ``semantic`` parts are not supported
     yet (the local observation carries no pedestrian types or social states).
 
+    The machinery (observation rebuilding, numpy inference, command limiting) lives in
+    :class:`PolicyPlanner`, which other learned planners (``rlca``) subclass with their own
+    weights and observation parts.
+
 Arguments:
     See :class:`LearnedPlanner.Params`.
 """
@@ -24,7 +28,7 @@ Arguments:
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -105,28 +109,27 @@ def resample_scan(
     return np.clip(out, 0.0, range_max)
 
 
-@LOCAL_PLANNERS.register("rosnav_rl", tags=("learned",))
-class LearnedPlanner:
-    """A trained PPO actor (numpy inference) driving the robot."""
+class PolicyPlanner:
+    """Base of the planners that run an exported PPO actor (numpy inference).
+
+    Subclasses set :attr:`planner_name` (in messages), :attr:`default_weights` (the packaged
+    file) and :attr:`supported_keys` (observation parts :meth:`observation` may rebuild), and
+    define a ``Params`` model with ``weights`` and ``subgoal_horizon`` (see
+    :class:`LearnedPlanner.Params`). Observation parts: ``lidar`` (the last ``stack`` scans,
+    resampled onto the policy's beams), ``goal`` (``[ρ m, θ rad]`` to the subgoal on the global
+    path), ``last_action`` (the planner's previous command) and ``velocity`` (the measured body
+    twist ``[vx, vy, ω]`` of the observation).
+    """
 
     supports: ClassVar[frozenset[str]] = frozenset({"diff_drive", "omni", "legged"})
+    planner_name: ClassVar[str] = "rosnav_rl"
+    default_weights: ClassVar[Path] = DEFAULT_WEIGHTS
+    supported_keys: ClassVar[frozenset[str]] = SUPPORTED_KEYS
+    params: Any
 
-    class Params(BaseModel):
-        """Parameters of ``rosnav_rl``."""
-
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        weights: str | None = Field(
-            None, description="exported policy (.npz, RUN/policy.npz); None: the packaged one"
-        )
-        subgoal_horizon: float | Literal["policy"] | None = Field(
-            "policy",
-            description="m along the path to the subgoal (Arena: 5.0); None: goal; policy: "
-            "the horizon the policy was trained with (observation.subgoal), else 5.0",
-        )
-
-    def __init__(self, params: Params | None = None) -> None:
-        self.params = p = params or self.Params()
-        path = Path(p.weights) if p.weights is not None else DEFAULT_WEIGHTS
+    def __init__(self, params: Any = None) -> None:
+        self.params = p = params if params is not None else self._default_params()
+        path = Path(p.weights) if p.weights is not None else self.default_weights
         if not path.is_file():
             raise ConfigError(
                 f"no policy file {str(path)!r}: train one with `arena train CONFIG -o RUN` and "
@@ -136,14 +139,15 @@ class LearnedPlanner:
         self.policy = NumpyPolicy.load(path)
         if not self.policy.is_dict:
             raise ConfigError(
-                f"{path}: rosnav_rl needs a Dict-observation policy (observation.flatten: false)",
+                f"{path}: {self.planner_name} needs a Dict-observation policy "
+                "(observation.flatten: false)",
                 path="navigation.local_planner.weights",
             )
-        extra = set(self.policy.keys) - SUPPORTED_KEYS
+        extra = set(self.policy.keys) - self.supported_keys
         if extra:
             raise ConfigError(
-                f"{path}: observation parts {sorted(extra)} are not supported by rosnav_rl "
-                f"(supported: {sorted(SUPPORTED_KEYS)})",
+                f"{path}: observation parts {sorted(extra)} are not supported by "
+                f"{self.planner_name} (supported: {sorted(self.supported_keys)})",
                 path="navigation.local_planner.weights",
             )
         if self.policy.meta.get("command") is None:
@@ -174,6 +178,9 @@ class LearnedPlanner:
         else:
             self.horizon = p.subgoal_horizon
         self.reset()
+
+    def _default_params(self) -> Any:
+        return type(self).Params()  # type: ignore[attr-defined]
 
     def reset(self) -> None:
         """Forget the scan history and the last command."""
@@ -207,6 +214,11 @@ class LearnedPlanner:
             out["last_action"] = np.clip(
                 self._last, pol.arrays["low/last_action"], pol.arrays["high/last_action"]
             ).astype(np.float32)
+        if "velocity" in pol.keys:
+            twist = np.asarray(obs.twist, dtype=np.float64).reshape(3)
+            out["velocity"] = np.clip(
+                twist, pol.arrays["low/velocity"], pol.arrays["high/velocity"]
+            ).astype(np.float32)
         return out
 
     def compute(self, obs: LocalObservation) -> NDArray[np.float64]:
@@ -219,3 +231,24 @@ class LearnedPlanner:
         out = finish_command(cmd, twist, lim, float(obs.dt), car)
         self._last = out.copy()
         return out
+
+
+@LOCAL_PLANNERS.register("rosnav_rl", tags=("learned",))
+class LearnedPlanner(PolicyPlanner):
+    """A trained PPO actor (numpy inference) driving the robot."""
+
+    class Params(BaseModel):
+        """Parameters of ``rosnav_rl``."""
+
+        model_config = ConfigDict(frozen=True, extra="forbid")
+        weights: str | None = Field(
+            None, description="exported policy (.npz, RUN/policy.npz); None: the packaged one"
+        )
+        subgoal_horizon: float | Literal["policy"] | None = Field(
+            "policy",
+            description="m along the path to the subgoal (Arena: 5.0); None: goal; policy: "
+            "the horizon the policy was trained with (observation.subgoal), else 5.0",
+        )
+
+    def __init__(self, params: Params | None = None) -> None:
+        super().__init__(params)
