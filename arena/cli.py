@@ -478,11 +478,17 @@ def train(
     progress: Annotated[
         bool, typer.Option("--progress/--no-progress", help="show a progress bar")
     ] = True,
+    export: Annotated[
+        Path | None,
+        typer.Option("--export", help="only write CHECKPOINT/policy.npz from a checkpoint "
+                     "folder (RUN/checkpoints/step_N), or the file -o names"),
+    ] = None,
 ) -> None:
     r"""Train a PPO policy on arena/SocialNav-v0 (pip install 'arena\[train]').
 
     Writes checkpoints, TensorBoard logs, ``run.json`` and the final ``policy.npz`` (for the
-    ``rosnav_rl`` local planner) into the run folder; ``--resume RUN_DIR`` continues a run.
+    ``rosnav_rl`` local planner) into the run folder; ``--resume RUN_DIR`` continues a run;
+    ``--export RUN/checkpoints/step_N`` writes the policy of an earlier checkpoint.
     """
     # before numba/OpenMP start threads: idle workers sleep instead of spinning, so that the
     # batched simulator's parallel loops do not steal cores from torch (see arena.sim.batch)
@@ -495,6 +501,11 @@ def train(
     from arena.learn.train_config import TrainSettings
 
     require_sb3()
+    if export is not None:
+        from arena.learn.train import export_checkpoint
+
+        console.print(f"wrote {export_checkpoint(export, out)}")
+        return
     items = ([config] if config else []) + list(overrides or [])
     path = None
     if items and "=" not in items[0]:

@@ -384,9 +384,13 @@ def _callbacks() -> dict[str, type]:
             super().__init__()
             self.trainer = trainer
 
-        def _on_step(self) -> bool:
+        def _on_rollout_start(self) -> None:
+            # between rollouts, after the previous update: the saved model has learnt from
+            # every step it counts (inside a rollout the last update would be missing)
             if self.num_timesteps - self.trainer.last_checkpoint >= self.trainer.every_ckpt:
                 self.trainer.checkpoint()
+
+        def _on_step(self) -> bool:
             return True
 
     class EvalCurriculumCallback(BaseCallback):
@@ -660,8 +664,8 @@ def train(
                         tb_log_name="PPO")
         elapsed = time.perf_counter() - start
         steps = int(model.num_timesteps)
-        if manifest.get("steps_done") != steps or manifest.get("checkpoint") is None:
-            checkpoint()
+        if remaining > 0 or manifest.get("checkpoint") is None:
+            checkpoint()  # the final model, after the last update
         rate = (steps - done) / elapsed if elapsed > 0 else 0.0
         manifest["steps_per_second"] = rate
         _write_json(manifest_path, manifest)
@@ -679,6 +683,47 @@ def train(
     return TrainResult(run, steps, t.stage, rate, policy_path, t.last_success)
 
 
+def export_checkpoint(checkpoint: str | Path, out: str | Path | None = None) -> Path:
+    """Write the numpy policy of one checkpoint of a run (``RUN/checkpoints/step_N``).
+
+    Training keeps its best policy in some checkpoint, not always the last one; this writes
+    that checkpoint's actor exactly as the end of :func:`train` writes ``RUN/policy.npz``.
+
+    Args:
+        checkpoint: a checkpoint folder (``model.zip`` + ``vecnormalize.pkl``) inside a run.
+        out: output file; default ``<checkpoint>/policy.npz``.
+
+    Raises:
+        ArenaError: not a checkpoint of a run, or torch/SB3 missing.
+    """
+    require_sb3()
+    import pickle
+
+    from stable_baselines3 import PPO
+
+    from arena.learn.actions import ActionDecoder
+    from arena.learn.policy import export_policy
+    from arena.robots.presets import load_robot
+
+    ckpt = Path(checkpoint)
+    if not (ckpt / "model.zip").is_file():
+        raise ArenaError(f"{ckpt}: no model.zip; give a checkpoint folder RUN/checkpoints/step_N")
+    manifest = read_run(ckpt.parent.parent)
+    cfg = ExperimentConfig.model_validate(manifest["config"])
+    settings = TrainSettings.model_validate(manifest["settings"])
+    vecnorm = None
+    if settings.ppo.normalize.norm_obs:
+        with open(ckpt / "vecnormalize.pkl", "rb") as f:  # statistics only, no env needed
+            vecnorm = pickle.load(f)
+    model = PPO.load(ckpt / "model.zip", device="cpu")
+    rob = load_robot(cfg.robot)
+    return export_policy(
+        model, vecnorm, Path(out) if out is not None else ckpt / "policy.npz",
+        decoder=ActionDecoder(cfg.learning.env.action, rob),
+        observation=cfg.learning.env.observation.model_dump(mode="json"), laser=rob.laser,
+    )
+
+
 def summary(result: TrainResult) -> str:
     """One line describing a finished run."""
     stage = "" if result.stage is None else f", stage {result.stage}"
@@ -694,6 +739,7 @@ __all__ = [
     "LinearSchedule",
     "TrainResult",
     "check_resume",
+    "export_checkpoint",
     "load_training",
     "make_vec_env",
     "read_run",

@@ -6,6 +6,7 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 pytest.importorskip("torch")
@@ -16,6 +17,7 @@ from arena.core.errors import ArenaError, ConfigError
 from arena.learn.train import (
     CurriculumController,
     LinearSchedule,
+    export_checkpoint,
     load_training,
     read_run,
     train,
@@ -50,6 +52,17 @@ def test_smoke_run_checkpoint_tensorboard_and_resume(tmp_path):
     assert (run / "checkpoints" / "step_32" / "model.zip").is_file()
     assert list((run / "tb").rglob("events.out.tfevents.*"))
     assert (run / "policy.npz").is_file()
+    # the last checkpoint exported on its own gives the run's final policy
+    exported = np.load(export_checkpoint(run / man["checkpoint"], tmp_path / "last.npz"))
+    final = np.load(run / "policy.npz")
+    arrays = [k for k in final.files if k != "meta"]
+    assert any(k.startswith("w") for k in arrays)
+    for k in arrays:
+        assert np.array_equal(exported[k], final[k]), k
+    assert (run / "checkpoints" / "step_32" / "policy.npz") == export_checkpoint(
+        run / "checkpoints" / "step_32")
+    with pytest.raises(ArenaError, match=r"no model\.zip"):
+        export_checkpoint(run)
     with pytest.raises(ArenaError, match="already holds a run"):
         train(cfg, _settings(), run, robot=small_robot(8))
     bad = TrainSettings.model_validate({**TINY, "ppo": {**TINY["ppo"], "n_epochs": 2}})
