@@ -121,6 +121,7 @@ class SocialNavEnv(gym.Env[Any, Any]):
         res = self.driver.step(np.asarray(action)[None, ...])
         info = self.driver.info()
         info["outcome"] = res.outcomes[0]
+        info["is_success"] = res.outcomes[0] == "success"  # SB3 logs rollout/success_rate
         info["reward_terms"] = {k: float(v[0]) for k, v in res.reward.terms.items()}
         info["collision"] = bool(res.collision[0])
         obs = self.driver.obs_builder.single(res.obs)

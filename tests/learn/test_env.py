@@ -87,7 +87,7 @@ def test_truncates_at_max_steps_with_timeout_outcome():
     for _ in range(2):
         assert env.step(stop)[3] is False
     _, r, term, trunc, info = env.step(stop)
-    assert trunc and not term and info["outcome"] == "timeout"
+    assert trunc and not term and info["outcome"] == "timeout" and not info["is_success"]
     assert info["reward_terms"]["max_steps_exceeded"] == -10.0
     assert r == pytest.approx(sum(info["reward_terms"].values()))
 
@@ -98,7 +98,7 @@ def test_goal_reached_terminates_with_success():
     driver = env.driver
     driver.goals[0, :2] = driver.state.robots.poses[0, :2]  # goal under the robot
     _, _, term, trunc, info = env.step(np.zeros(2, np.float32))
-    assert term and not trunc and info["outcome"] == "success"
+    assert term and not trunc and info["outcome"] == "success" and info["is_success"]
     assert info["reward_terms"]["goal_reached"] == 15.0
 
 
