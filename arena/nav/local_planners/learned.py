@@ -109,16 +109,29 @@ def resample_scan(
     return np.clip(out, 0.0, range_max)
 
 
+class PolicyParams(BaseModel):
+    """Parameters shared by the planners that run an exported policy (``rosnav_rl``, ``rlca``)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    weights: str | None = Field(
+        None, description="exported policy (.npz, RUN/policy.npz); None: the packaged one"
+    )
+    subgoal_horizon: float | Literal["policy"] | None = Field(
+        "policy",
+        description="m along the path to the subgoal (Arena: 5.0); None: the goal itself; "
+        "policy: the horizon the policy was trained with (observation.subgoal), else 5.0",
+    )
+
+
 class PolicyPlanner:
     """Base of the planners that run an exported PPO actor (numpy inference).
 
     Subclasses set :attr:`planner_name` (in messages), :attr:`default_weights` (the packaged
     file) and :attr:`supported_keys` (observation parts :meth:`observation` may rebuild), and
-    define a ``Params`` model with ``weights`` and ``subgoal_horizon`` (see
-    :class:`LearnedPlanner.Params`). Observation parts: ``lidar`` (the last ``stack`` scans,
-    resampled onto the policy's beams), ``goal`` (``[ρ m, θ rad]`` to the subgoal on the global
-    path), ``last_action`` (the planner's previous command) and ``velocity`` (the measured body
-    twist ``[vx, vy, ω]`` of the observation).
+    define a ``Params`` model deriving from :class:`PolicyParams`. Observation parts: ``lidar``
+    (the last ``stack`` scans, resampled onto the policy's beams), ``goal`` (``[ρ m, θ rad]``
+    to the subgoal on the global path), ``last_action`` (the planner's previous command) and
+    ``velocity`` (the measured body twist ``[vx, vy, ω]`` of the observation).
     """
 
     supports: ClassVar[frozenset[str]] = frozenset({"diff_drive", "omni", "legged"})
@@ -237,18 +250,8 @@ class PolicyPlanner:
 class LearnedPlanner(PolicyPlanner):
     """A trained PPO actor (numpy inference) driving the robot."""
 
-    class Params(BaseModel):
+    class Params(PolicyParams):
         """Parameters of ``rosnav_rl``."""
-
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        weights: str | None = Field(
-            None, description="exported policy (.npz, RUN/policy.npz); None: the packaged one"
-        )
-        subgoal_horizon: float | Literal["policy"] | None = Field(
-            "policy",
-            description="m along the path to the subgoal (Arena: 5.0); None: goal; policy: "
-            "the horizon the policy was trained with (observation.subgoal), else 5.0",
-        )
 
     def __init__(self, params: Params | None = None) -> None:
         super().__init__(params)

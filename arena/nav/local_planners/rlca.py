@@ -28,12 +28,10 @@ Arguments:
 from __future__ import annotations
 
 from pathlib import Path
-from typing import ClassVar, Literal
-
-from pydantic import BaseModel, ConfigDict, Field
+from typing import ClassVar
 
 from arena.nav.local_planners.base import LOCAL_PLANNERS
-from arena.nav.local_planners.learned import PolicyPlanner
+from arena.nav.local_planners.learned import PolicyParams, PolicyPlanner
 
 RLCA_WEIGHTS = Path(__file__).resolve().parents[2] / "learn" / "data" / "policies" / "rlca.npz"
 """The packaged policy (``arena/learn/data/policies/rlca.npz``)."""
@@ -49,18 +47,8 @@ class RLCAPlanner(PolicyPlanner):
         {"lidar", "goal", "velocity", "last_action"}
     )
 
-    class Params(BaseModel):
+    class Params(PolicyParams):
         """Parameters of ``rlca``."""
-
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        weights: str | None = Field(
-            None, description="exported policy (.npz, RUN/policy.npz); None: the packaged one"
-        )
-        subgoal_horizon: float | Literal["policy"] | None = Field(
-            "policy",
-            description="m along the path to the subgoal; None: the goal itself; policy: the "
-            "horizon the policy was trained with (observation.subgoal), else 5.0",
-        )
 
     def __init__(self, params: Params | None = None) -> None:
         super().__init__(params)
