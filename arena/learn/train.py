@@ -580,6 +580,8 @@ def train(
             venv = VecNormalize.load(str(ckpt / "vecnormalize.pkl"), venv)
             venv.training = True
             model = PPO.load(ckpt / "model.zip", env=venv, device=tr.device)
+            # model.zip stores the folder it logged to; a copied or moved run logs here
+            model.tensorboard_log = str(run / "tb") if tr.tensorboard else None
             venv.seed(seed + done)
         else:
             venv = VecNormalize(

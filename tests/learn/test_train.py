@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 import subprocess
 import sys
 
@@ -68,10 +69,15 @@ def test_smoke_run_checkpoint_tensorboard_and_resume(tmp_path):
     bad = TrainSettings.model_validate({**TINY, "ppo": {**TINY["ppo"], "n_epochs": 2}})
     with pytest.raises(ArenaError, match=r"cannot resume: settings key 'ppo\.n_epochs'"):
         train(cfg, bad, run, resume=True, robot=small_robot(8))
-    res2 = train(cfg, _settings(total_steps=128), run, resume=True, robot=small_robot(8))
+    copy = tmp_path / "copy"  # a copied run resumes and logs into its own folder
+    shutil.copytree(run, copy)
+    shutil.rmtree(copy / "tb")
+    res2 = train(cfg, _settings(total_steps=128), copy, resume=True, robot=small_robot(8))
     assert res2.steps == 128
-    assert read_run(run)["steps_done"] == 128
-    assert (run / "checkpoints" / "step_128" / "model.zip").is_file()
+    assert read_run(copy)["steps_done"] == 128
+    assert (copy / "checkpoints" / "step_128" / "model.zip").is_file()
+    assert list((copy / "tb").rglob("events.out.tfevents.*"))
+    assert read_run(run)["steps_done"] == 64 and not (run / "checkpoints" / "step_128").exists()
 
 
 def test_curriculum_run_applies_stage(tmp_path):
