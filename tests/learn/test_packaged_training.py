@@ -30,3 +30,22 @@ def test_shipped_policy_was_trained_with_its_config(name):
     want = cfg.learning.env.observation.model_dump(mode="json")
     have = meta["observation"]
     assert {k: have[k] for k in have} == {k: want[k] for k in have}
+
+
+def _strings(x):
+    if isinstance(x, dict):
+        for v in x.values():
+            yield from _strings(v)
+    elif isinstance(x, list):
+        for v in x:
+            yield from _strings(v)
+    elif isinstance(x, str):
+        yield x
+
+
+@pytest.mark.parametrize("name", sorted(p.stem for p in (DATA / "policies").glob("*.npz")))
+def test_shipped_policy_meta_names_no_local_folders(name):
+    """A shipped file records where it came from relative to the repository, not a machine."""
+    with np.load(DATA / "policies" / f"{name}.npz") as f:
+        meta = json.loads(str(f["meta"]))
+    assert not [s for s in _strings(meta) if Path(s).is_absolute()]

@@ -96,6 +96,18 @@ FloatArray = NDArray[np.float64]
 
 DEFAULT_CONFIG = Path(__file__).resolve().parents[1] / "data" / "train" / "value_policy.yaml"
 """The packaged training config (``arena/learn/data/train/value_policy.yaml``)."""
+
+
+def _portable(path: str) -> str:
+    """``path`` relative to the repository when it lies inside it, else as given.
+
+    Shipped policy files should not carry the folders of the machine that trained them.
+    """
+    root = Path(__file__).resolve().parents[3]
+    try:
+        return Path(path).resolve().relative_to(root).as_posix()
+    except ValueError:
+        return path
 PASS_DISTANCE = 1.0
 """m: a robot that never comes within its radius of a local goal reaches it at its closest pass
 when that pass is this close (the demonstrator cuts path corners)."""
@@ -524,8 +536,10 @@ def train(settings: TrainSettings, out: Path, *,
                                           "loss"])
         w.writeheader()
         w.writerows(rows)
+    settings = asdict(s)
+    settings["config"] = _portable(s.config)
     summary = {
-        "settings": asdict(s),
+        "settings": settings,
         "il": {"episodes": s.il_episodes, "outcomes": outcomes, "samples": ticks,
                "gradient_steps": il_steps, "final_loss": il_loss,
                "demo_wall_s": round(il_demo_s, 1)},
