@@ -536,10 +536,10 @@ def train(settings: TrainSettings, out: Path, *,
                                           "loss"])
         w.writeheader()
         w.writerows(rows)
-    settings = asdict(s)
-    settings["config"] = _portable(s.config)
+    recorded = asdict(s)
+    recorded["config"] = _portable(s.config)
     summary = {
-        "settings": settings,
+        "settings": recorded,
         "il": {"episodes": s.il_episodes, "outcomes": outcomes, "samples": ticks,
                "gradient_steps": il_steps, "final_loss": il_loss,
                "demo_wall_s": round(il_demo_s, 1)},
