@@ -81,6 +81,22 @@ def _linear_layers(seq: Any) -> tuple[list[Any], str]:
     return layers, next(iter(acts), "identity")
 
 
+def _command_arrays(decoder: Any, arrays: dict[str, NDArray[Any]]) -> dict[str, Any]:
+    """Add the action decoding of ``decoder`` (an ActionDecoder) to ``arrays``; its meta."""
+    arrays["command_low"] = np.asarray(decoder.low, np.float64)
+    arrays["command_high"] = np.asarray(decoder.high, np.float64)
+    if decoder.table is not None:
+        arrays["command_table"] = np.asarray(decoder.table, np.float64)
+        return {"type": "table"}
+    arrays["range_low"] = np.asarray(decoder.range_low, np.float64)
+    arrays["range_high"] = np.asarray(decoder.range_high, np.float64)
+    return {
+        "type": "box",
+        "holonomic": bool(decoder.holonomic),
+        "normalize": bool(decoder.config.normalize),
+    }
+
+
 def export_policy(
     model: Any,
     vecnormalize: Any | None,
@@ -195,21 +211,7 @@ def export_policy(
     else:
         raise ValueError(f"action distribution {type(dist).__name__} cannot be exported")
 
-    command: dict[str, Any] | None = None
-    if decoder is not None:
-        arrays["command_low"] = np.asarray(decoder.low, np.float64)
-        arrays["command_high"] = np.asarray(decoder.high, np.float64)
-        if decoder.table is not None:
-            arrays["command_table"] = np.asarray(decoder.table, np.float64)
-            command = {"type": "table"}
-        else:
-            arrays["range_low"] = np.asarray(decoder.range_low, np.float64)
-            arrays["range_high"] = np.asarray(decoder.range_high, np.float64)
-            command = {
-                "type": "box",
-                "holonomic": bool(decoder.holonomic),
-                "normalize": bool(decoder.config.normalize),
-            }
+    command = _command_arrays(decoder, arrays) if decoder is not None else None
 
     meta = {
         "format": FORMAT if fx_meta is None else FORMAT_CONV,
@@ -302,19 +304,7 @@ def random_policy(
         scale = np.sqrt(2.0 / a) if i < len(widths) - 2 else 1.0 / np.sqrt(a)
         arrays[f"w{i}"] = (gen.standard_normal((b, a)) * scale).astype(np.float32)
         arrays[f"b{i}"] = np.zeros(b, np.float32)
-    arrays["command_low"] = np.asarray(decoder.low, np.float64)
-    arrays["command_high"] = np.asarray(decoder.high, np.float64)
-    if decoder.table is not None:
-        arrays["command_table"] = np.asarray(decoder.table, np.float64)
-        command: dict[str, Any] = {"type": "table"}
-    else:
-        arrays["range_low"] = np.asarray(decoder.range_low, np.float64)
-        arrays["range_high"] = np.asarray(decoder.range_high, np.float64)
-        command = {
-            "type": "box",
-            "holonomic": bool(decoder.holonomic),
-            "normalize": bool(decoder.config.normalize),
-        }
+    command = _command_arrays(decoder, arrays)
     keys = list(sub)
     meta = {
         "format": FORMAT,
