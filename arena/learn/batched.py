@@ -35,6 +35,8 @@ Info (arrays over worlds, each key ``k`` with its mask ``_k``, gymnasium's vecto
 
 from __future__ import annotations
 
+import os
+import warnings
 from collections.abc import Sequence
 from functools import partial
 from typing import Any
@@ -162,6 +164,12 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         self._stage: int | None = None
         if prefetch < 0:
             raise ValueError(f"prefetch must be >= 0 episodes per world, got {prefetch}")
+        if prefetch and os.name == "nt":
+            warnings.warn(
+                "episode prefetching needs a POSIX system (it passes pipes to a helper process); "
+                "drawing episodes in this process instead", RuntimeWarning, stacklevel=2,
+            )
+            prefetch = 0
         self.prefetch = int(prefetch)
         self._prefetcher: EpisodePrefetcher | None = None
         if self.prefetch:

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from arena.core.geometry import wrap_angle
 from arena.crowd.base import RobotView
 from arena.crowd.social import (
     TARGET_AGENT,
@@ -17,9 +18,19 @@ from arena.crowd.social import (
     RobotAvoidanceParams,
     SocialStates,
     SocialStatesParams,
+    Vision,
     sample_agent_params,
 )
+from arena.crowd.social import kernels as K
+from arena.crowd.social import perception as P
+from arena.crowd.social.perception import (
+    nearest_seen_agents,
+    nearest_seen_robots,
+    nearest_seen_wall_points,
+)
+from arena.crowd.social.robots import robot_fear
 from arena.crowd.state import AgentType, CrowdState, SocialState
+from arena.crowd.walls import WallIndex, world_segments
 from arena.maps.grid import OccupancyGrid
 from arena.sim.state import Obstacle, StaticWorld
 
@@ -261,6 +272,21 @@ def test_robot_fear_only_in_personal_space_and_more_for_fast_robots():
     )
 
 
+def test_fear_from_many_robots_adds_up():
+    # More robots than the kernel sums itself: numpy's pairwise sum is passed in.
+    human = exact_human(d_stress=0.0, walking_d_stress=0.0)
+    social = machine(human=human, interested_in_robots=False)
+    state = make_state([[0.0, 0.0], [20.0, 0.0]])
+    social.reset(state, None, np.random.default_rng(0))
+    r = K.MAX_SEQUENTIAL_ROBOTS + 2
+    ring = 0.5 * np.stack([np.cos(np.arange(r)), np.sin(np.arange(r))], axis=1)
+    robots = robots_at(ring, np.full((r, 2), [0.0, 1.0]))
+    dt = 0.001
+    social.pre(state, robots, None, dt)
+    rate = SocialStatesParams().fear_rate_hz
+    np.testing.assert_allclose(state.stress, [dt * rate * r * (0.02 + 1.0 - 0.7), 0.0])
+
+
 def test_robot_avoidance_pushes_away_and_decays():
     prm = RobotAvoidanceParams(enabled=True, strength=2.0, range_factor=0.5, cutoff_factor=2.0)
     social = machine(robot_avoidance=prm, interested_in_robots=False)
@@ -450,3 +476,82 @@ def test_same_seed_same_sequence():
     assert any(not np.array_equal(x[0], y[0]) for x, y in zip(a, c, strict=True))
     states = np.concatenate([x[0] for x in a])
     assert {S.TALKING, S.INTERACTING, S.RUNNING} <= set(states.tolist())  # chart exercised
+
+
+# -- kernels against the numpy reference ----------------------------------------------------------
+def _perception_table(rng: np.random.Generator, n: int) -> np.ndarray:
+    """A kernel parameter table with random vision and fear rows."""
+    table = np.zeros((K.N_ROWS, n))
+    table[K.VISION_RANGE] = rng.uniform(1.0, 6.0, n)
+    table[K.VISION_HALF_ANGLE] = rng.uniform(0.2, np.pi, n)
+    table[K.PSR] = rng.uniform(0.3, 1.5, n)
+    table[K.VISION_NEAR] = 1.1 * table[K.PSR]
+    table[K.FEAR_ROBOT] = rng.uniform(0.0, 0.1, n)
+    table[K.FEAR_TOLERANCE] = rng.uniform(0.0, 1.0, n)
+    return table
+
+
+@pytest.mark.parametrize("lattice", [False, True])
+@pytest.mark.parametrize("seed", range(4))
+def test_kernel_perception_equals_the_numpy_reference(seed, lattice):
+    rng = np.random.default_rng(seed)
+    n = 40
+    if lattice:  # whole metres: many exact distance ties, which must go the same way
+        pos = rng.integers(0, 8, (n, 2)).astype(float)
+        heads = rng.integers(-2, 3, n) * (np.pi / 2)
+    else:
+        pos = rng.uniform(0.0, 8.0, (n, 2))
+        heads = rng.uniform(-np.pi, np.pi, n)
+    table = _perception_table(rng, n)
+    if lattice:
+        table[K.VISION_HALF_ANGLE] = np.pi
+    vis = (table[K.VISION_RANGE], table[K.VISION_HALF_ANGLE], table[K.VISION_NEAR])
+    vision = Vision(*vis)
+    box = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+    obstacles = tuple(
+        Obstacle(f"o{i}", "cuboid", np.array([x, y, 0.0]), box)
+        for i, (x, y) in enumerate(rng.uniform(1.0, 7.0, (3, 2)))
+    )
+    world = StaticWorld.build(OccupancyGrid.empty(80, 80, 0.1), obstacles)
+    index = WallIndex(*world_segments(world))
+    arrays = P.wall_index_arrays(index)
+    robot_pos = rng.uniform(0.0, 8.0, (K.MAX_SEQUENTIAL_ROBOTS, 2))
+    robot_vel = rng.normal(0.0, 1.0, robot_pos.shape)
+    everyone = np.arange(n)
+    want_agent = nearest_seen_agents(vision, pos, heads, everyone)
+    want_robot = nearest_seen_robots(vision, pos, heads, everyone, robot_pos)
+    want_found, want_point = nearest_seen_wall_points(vision, pos, heads, everyone, index)
+    want_fear = robot_fear(
+        pos,
+        table[K.PSR],
+        table[K.FEAR_ROBOT],
+        table[K.FEAR_TOLERANCE],
+        RobotView(robot_pos, np.zeros(len(robot_pos)), robot_vel, np.full(len(robot_pos), 0.3)),
+    )
+    grid = P.cell_grid(pos, max(vision.reach, 1e-3))
+    buf = np.empty(max(n, len(index)), dtype=np.int64)
+    for i in range(n):
+        assert P.nearest_seen_agent(vis, pos, heads, grid, vision.reach, i, buf) == want_agent[i]
+        assert P.nearest_seen_robot(vis, pos, heads, robot_pos, i) == want_robot[i]
+        found, x, y = P.nearest_seen_wall_point(vis, pos, heads, arrays, vision.reach, i, buf)
+        assert found == want_found[i]
+        assert (x, y) == tuple(want_point[i])
+        assert K._fear(table, pos, robot_pos, robot_vel, i) == want_fear[i]
+    assert (want_agent >= 0).sum() > n // 2 and want_found.sum() > 0  # the queries found things
+
+
+def test_vision_cone_edge_is_decided_with_numpys_arctan2():
+    # numpy's SIMD arctan2 and libm's atan2 (what numba calls) may differ in the last bit: on the
+    # very edge of the cone the kernel must still answer as the numpy formulation does.
+    rng = np.random.default_rng(0)
+    checked = 0
+    for dx, dy in rng.normal(size=(20_000, 2)):
+        bearing = abs(float(wrap_angle(np.arctan2(dy, dx))))
+        if abs(float(wrap_angle(math.atan2(dy, dx)))) == bearing:
+            continue
+        for half in (bearing, np.nextafter(bearing, np.inf), np.nextafter(bearing, 0.0)):
+            assert P._in_cone(dx, dy, 0.0, half) == (bearing < half)
+        checked += 1
+        if checked == 20:
+            break
+    assert checked == 20

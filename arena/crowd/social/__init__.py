@@ -1,7 +1,8 @@
 """Pedestrian social states (Arena's crowdsim statechart).
 
-Split into ``params`` (distributions and their sampling), ``perception`` (vision) and
-``statechart`` (:class:`SocialStates`). Use::
+Split into ``params`` (distributions and their sampling), ``perception`` (vision),
+``kernels`` (one tick of the statechart, compiled) and ``statechart`` (:class:`SocialStates`).
+Use::
 
     from arena.crowd.social import SocialStates, SocialStatesParams
 
