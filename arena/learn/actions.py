@@ -65,6 +65,8 @@ class ActionDecoder:
             else:
                 vw = custom_grid(xr, cont.angular_range, config.n_linear, config.n_angular)
             self.table = np.column_stack([vw[:, 0], np.zeros(len(vw)), vw[:, 1]])
+            # clipped once: clipping is elementwise, so clip(table)[idx] == clip(table[idx])
+            self._clipped_table = np.clip(self.table, self.low, self.high)
             self.space = spaces.Discrete(len(self.table))
         else:
             if self.holonomic:
@@ -87,18 +89,18 @@ class ActionDecoder:
         """
         if self.table is not None:
             idx = np.asarray(actions, dtype=np.int64).reshape(-1)
-            cmd = self.table[idx]
+            table_cmd: FloatArray = self._clipped_table[idx]  # a fresh array (fancy indexing)
+            return table_cmd
+        a = np.asarray(actions, dtype=np.float64)
+        d = 3 if self.holonomic else 2
+        a = a.reshape(-1, d)
+        if self.config.normalize:
+            a = self.range_low + (np.clip(a, -1.0, 1.0) + 1.0) / 2.0 * (
+                self.range_high - self.range_low
+            )
+        cmd = np.zeros((a.shape[0], 3))
+        if self.holonomic:
+            cmd[:] = a
         else:
-            a = np.asarray(actions, dtype=np.float64)
-            d = 3 if self.holonomic else 2
-            a = a.reshape(-1, d)
-            if self.config.normalize:
-                a = self.range_low + (np.clip(a, -1.0, 1.0) + 1.0) / 2.0 * (
-                    self.range_high - self.range_low
-                )
-            cmd = np.zeros((a.shape[0], 3))
-            if self.holonomic:
-                cmd[:] = a
-            else:
-                cmd[:, 0], cmd[:, 2] = a[:, 0], a[:, 1]
+            cmd[:, 0], cmd[:, 2] = a[:, 0], a[:, 1]
         return np.clip(cmd, self.low, self.high)

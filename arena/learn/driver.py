@@ -238,7 +238,10 @@ class EpisodeDriver:
         self.goals = np.array([s.goal.as_array() for s in ep.robots])
         self.last_action[:] = 0.0
         self.active[:] = True
-        self.scans[:] = np.stack(self.state.robots.scans)[:, None, :]
+        # a new array, not written in place: after a step self.scans may be a view of a snapshot
+        self.scans = np.repeat(
+            np.stack(self.state.robots.scans)[:, None, :], self.scans.shape[1], axis=1
+        )
         self._renderer: Any = None  # drawn lazily, once per episode (the world changes)
         # per-episode constants of the reward input (allocated once, never written to)
         r = self.n_robots
@@ -274,9 +277,12 @@ class EpisodeDriver:
             np.ones((r, m), dtype=bool),
         )
 
-    def _obs_input(self) -> ObsInput:
+    def _obs_input(
+        self, peds: tuple[FloatArray, FloatArray, Any, Any, Any] | None = None
+    ) -> ObsInput:
+        """The observation input of the current state (``peds``: :meth:`_peds` if known)."""
         assert self.state is not None
-        pos, vel, kind, st, mask = self._peds()
+        pos, vel, kind, st, mask = self._peds() if peds is None else peds
         rs = self.state.robots
         goals = self.goals[:, :2] if self.subgoals is None else self.subgoals.current
         return ObsInput(
@@ -298,20 +304,25 @@ class EpisodeDriver:
         """
         assert self.state is not None
         assert self.episode is not None
-        cmd = self.decoder.decode(actions)
-        cmd[~self.active] = 0.0
+        cmd = self.decoder.decode(actions)  # a fresh array
+        if not all(self.active.tolist()):  # a short list: cheaper than ndarray.all
+            cmd[~self.active] = 0.0
         prev_heading = self.state.robots.poses[:, 2].copy()
         prev_dist = self.goal_distance()
         if self.substeps == 1:
             self.state = self.backend.step(cmd, self.dt)
-            collision = np.array(self.state.collisions.any, dtype=bool)
+            collision = self.state.collisions.any  # a fresh array
         else:
             collision = np.zeros(self.n_robots, dtype=bool)
             for _ in range(self.substeps):
                 self.state = self.backend.step(cmd, self.dt)
                 collision |= self.state.collisions.any
         self.steps += 1
-        scans = np.stack(self.state.robots.scans)
+        r = self.n_robots
+        robot_scans = self.state.robots.scans
+        # The snapshot's scans are copies the backend never writes to; views of them serve
+        # (reset replaces self.scans instead of writing into it).
+        scans = robot_scans[0][None] if r == 1 else np.stack(robot_scans)
         if self.scans.shape[1] == 1:
             self.scans = scans[:, None, :]
         else:
@@ -319,9 +330,9 @@ class EpisodeDriver:
         poses = self.state.robots.poses
         dist = self.goal_distance()
         goal_reached = dist < self.episode.goal_radius
-        r = self.n_robots
         c = self._consts
-        pos, _, kind, _, mask = self._peds()
+        peds = self._peds()
+        pos, _, kind, _, mask = peds
         d = pos - poses[:, None, :2]
         ped_d = np.hypot(d[..., 0], d[..., 1])
         inp = RewardInput(
@@ -339,7 +350,7 @@ class EpisodeDriver:
             heading=poses[:, 2].copy(),
             prev_heading=prev_heading,
             dt=c["dt"],
-            step=np.full(r, self.steps, dtype=np.int64),
+            step=np.array([self.steps] * r, dtype=np.int64),
             max_steps=c["max_steps"],
             ped_distance=ped_d,
             ped_kind=kind if kind.dtype == np.int64 else kind.astype(np.int64),
@@ -347,27 +358,36 @@ class EpisodeDriver:
         )
         out = self.reward_fn(inp)
         self.last_action = cmd
-        reason = out.reason
-        hit = reason == _COLLISION
-        term_reason = (reason == _SUCCESS) | hit
-        terminated = goal_reached | collision | (out.done & term_reason)
         limit = (self.steps >= self.env_cfg.max_steps) or (
             self.state.time >= self.episode.time_limit - 1e-9
         )
-        truncated = ~terminated & (limit | (out.done & ~term_reason))
+        # Per robot in Python (r is small): terminated on arrival, contact or a term ending the
+        # episode with success/collision; truncated at the limits or when another term ends it.
+        reached_l, collision_l = goal_reached.tolist(), collision.tolist()
+        done_l, reason_l = out.done.tolist(), out.reason.tolist()
+        term_l: list[bool] = []
+        trunc_l: list[bool] = []
         outcomes: list[str | None] = []
         for i in range(r):
-            if collision[i] or hit[i]:
+            hit = reason_l[i] == _COLLISION
+            term_reason = hit or reason_l[i] == _SUCCESS
+            terminated_i = reached_l[i] or collision_l[i] or (done_l[i] and term_reason)
+            truncated_i = not terminated_i and (limit or (done_l[i] and not term_reason))
+            term_l.append(terminated_i)
+            trunc_l.append(truncated_i)
+            if collision_l[i] or hit:
                 outcomes.append(_OUT_COLLISION)
-            elif terminated[i]:
+            elif terminated_i:
                 outcomes.append(_OUT_SUCCESS)
-            elif truncated[i]:
+            elif truncated_i:
                 outcomes.append(_OUT_TIMEOUT)
             else:
                 outcomes.append(None)
+        terminated = np.array(term_l, dtype=bool)
+        truncated = np.array(trunc_l, dtype=bool)
         if self.subgoals is not None:
             self.subgoals.update(poses, self.goals, self.state.time)
-        obs = self.obs_builder.build(self._obs_input())
+        obs = self.obs_builder.build(self._obs_input(peds))
         return StepResult(obs, out, goal_reached, collision, terminated, truncated, dist, outcomes)
 
     # -- rendering --------------------------------------------------------------------------
@@ -386,15 +406,20 @@ class EpisodeDriver:
         text = f"t = {self.state.time:5.1f} s   step {self.steps}"
         return self._renderer.render(self.state, Overlay(goals=self.goals, text=text))
 
-    def info(self, i: int = 0) -> dict[str, Any]:
-        """Status of robot ``i``: episode index, time (s), steps, goal distance (m)."""
+    def info(self, i: int = 0, *, goal_distance: FloatArray | None = None) -> dict[str, Any]:
+        """Status of robot ``i``: episode index, time (s), steps, goal distance (m).
+
+        ``goal_distance``: the ``(r,)`` :meth:`goal_distance` of the current state when the
+        caller has it (:attr:`StepResult.goal_distance` of the last step), to skip recomputing.
+        """
         assert self.state is not None
         assert self.episode is not None
+        dist = self.goal_distance() if goal_distance is None else goal_distance
         return {
             "episode_index": self.episode.index,
             "time": float(self.state.time),
             "steps": self.steps,
-            "goal_distance": float(self.goal_distance()[i]),
+            "goal_distance": float(dist[i]),
             "goal_radius": float(self.episode.goal_radius),
         }
 

@@ -119,7 +119,7 @@ class SocialNavEnv(gym.Env[Any, Any]):
         if not self._started:
             raise RuntimeError("call reset() before step()")
         res = self.driver.step(np.asarray(action)[None, ...])
-        info = self.driver.info()
+        info = self.driver.info(goal_distance=res.goal_distance)
         info["outcome"] = res.outcomes[0]
         info["is_success"] = res.outcomes[0] == "success"  # SB3 logs rollout/success_rate
         info["reward_terms"] = {k: float(v[0]) for k, v in res.reward.terms.items()}

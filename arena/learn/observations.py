@@ -88,10 +88,20 @@ class ObsInput:
 
 def goal_polar(poses: FloatArray, goals: FloatArray) -> FloatArray:
     """``(N, 2)`` ``[ρ, θ]``: distance (m) and bearing (rad, ``[−π, π)``, 0 straight ahead)."""
+    rho, theta = _goal_rho_theta(poses, goals)
+    out = np.empty((rho.shape[0], 2))
+    out[:, 0] = rho
+    out[:, 1] = theta
+    return out
+
+
+def _goal_rho_theta(poses: FloatArray, goals: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """:func:`goal_polar`'s columns ``(N,)`` each: ρ (m) and θ (rad)."""
     d = goals[:, :2] - poses[:, :2]
-    rho = np.hypot(d[:, 0], d[:, 1])
-    theta = (np.arctan2(d[:, 1], d[:, 0]) - poses[:, 2] + np.pi) % (2 * np.pi) - np.pi
-    return np.column_stack([rho, theta])
+    dx, dy = d[:, 0], d[:, 1]
+    rho = np.hypot(dx, dy)
+    theta = (np.arctan2(dy, dx) - poses[:, 2] + np.pi) % (2 * np.pi) - np.pi
+    return rho, theta
 
 
 def to_robot_frame(vectors: FloatArray, headings: FloatArray) -> FloatArray:
@@ -165,6 +175,8 @@ class ObservationBuilder:
             raise ValueError("the observation is empty: enable at least one part")
         self.dict_space = spaces.Dict(parts)
         self.keys = tuple(self.dict_space.keys())  # the order flatten_space uses
+        self._lidar = "lidar" in parts
+        self._goal = "goal" in parts
         # float64 copies of the last_action bounds: the float32 arrays would make each clip cast
         la = parts.get("last_action")
         self._action_bounds: tuple[FloatArray, FloatArray] | None = (
@@ -183,20 +195,21 @@ class ObservationBuilder:
         n = inp.poses.shape[0]
         out: Obs = {}
         cfg = self.config
-        if "lidar" in self.keys:
-            out["lidar"] = np.clip(inp.scans, 0.0, self.range_max).astype(np.float32)
-        if "goal" in self.keys:
-            g = goal_polar(inp.poses, inp.goals)
-            g[:, 0] = np.minimum(g[:, 0], cfg.goal_max_distance)
-            out["goal"] = g.astype(np.float32)
-        if "last_action" in self.keys:
-            assert self._action_bounds is not None
+        # The array method clip is np.clip without its dispatch layer (this runs every step).
+        if self._lidar:
+            out["lidar"] = inp.scans.clip(0.0, self.range_max).astype(np.float32)
+        if self._goal:
+            rho, theta = _goal_rho_theta(inp.poses, inp.goals)
+            goal = np.empty((n, 2), np.float32)  # assignment rounds to float32 as astype does
+            goal[:, 0] = np.minimum(rho, cfg.goal_max_distance)
+            goal[:, 1] = theta
+            out["goal"] = goal
+        if self._action_bounds is not None:
             lo, hi = self._action_bounds
-            out["last_action"] = np.clip(inp.last_action, lo, hi).astype(np.float32)
-        if "velocity" in self.keys:
-            assert self._velocity_bounds is not None
+            out["last_action"] = inp.last_action.clip(lo, hi).astype(np.float32)
+        if self._velocity_bounds is not None:
             lo, hi = self._velocity_bounds
-            out["velocity"] = np.clip(inp.twists, lo, hi).astype(np.float32)
+            out["velocity"] = inp.twists.clip(lo, hi).astype(np.float32)
         if cfg.pedestrians.enabled or cfg.semantic.enabled:
             rel = to_robot_frame(inp.ped_pos - inp.poses[:, None, :2], inp.poses[:, 2])
             if cfg.pedestrians.enabled:

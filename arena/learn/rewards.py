@@ -597,11 +597,18 @@ class RewardFunction:
         fired) skip only operations that would leave every value unchanged, so the output is
         bit-identical to the plain formula; they matter because a single env calls this with
         ``N = 1`` every step, where each numpy call costs more than its arithmetic.
+
+        For ``N = 1`` the sum, done flag and reason are kept as Python scalars while every
+        term's share has the shape ``(1,)`` (float64 additions in the same order, so the same
+        bits) and turned into arrays at the end.
         """
         n = inp.n
-        total = np.zeros(n)
-        done = np.zeros(n, dtype=bool)
-        reason = np.zeros(n, dtype=np.int64)
+        # scalar accumulators (N = 1): total, done, reason; arrays once a share has another shape
+        scalar = n == 1
+        total_1, done_1, reason_1 = 0.0, False, 0
+        total: FloatArray | None = None
+        done: BoolArray | None = None
+        reason: IntArray | None = None
         calm: BoolArray | None = None  # ~breached, computed once and only when a term needs it
         parts: dict[str, FloatArray] = {}
         for name, term, weight, on_violation in self._plan:
@@ -616,8 +623,33 @@ class RewardFunction:
                 r = np.where(calm, r, 0.0)
                 fired = fired & calm
             parts[name] = r
+            if scalar and r.shape == (1,) and fired.shape == (1,) and fired.dtype == np.bool_:
+                total_1 += float(r[0])
+                if fired[0]:
+                    done_1 = True
+                    reason_1 = max(reason_1, int(res.reason))
+                continue
+            if total is None:  # leave the scalar path (or never take it)
+                scalar = False
+                total, done, reason = _accumulators(n, total_1, done_1, reason_1)
+            assert done is not None
+            assert reason is not None
             total += r
             if fired.any():
                 done |= fired
                 reason = np.where(fired, np.maximum(reason, int(res.reason)), reason)
+        if total is None or done is None or reason is None:
+            total, done, reason = _accumulators(n, total_1, done_1, reason_1)
         return RewardOutput(total, parts, done, reason)
+
+
+def _accumulators(
+    n: int, total: float, done: bool, reason: int
+) -> tuple[FloatArray, BoolArray, IntArray]:
+    """The ``(n,)`` arrays of :class:`RewardOutput` filled with the scalar accumulators."""
+    # np.array of a short list: a third of np.full's cost (a Python function) for n = 1
+    return (
+        np.array([total] * n, dtype=np.float64),
+        np.array([done] * n, dtype=bool),
+        np.array([reason] * n, dtype=np.int64),
+    )

@@ -152,7 +152,9 @@ class Collisions:
     @property
     def any(self) -> NDArray[np.bool_]:
         """``(r,)`` bool: the robot touches anything."""
-        return self.wall | (self.obstacle >= 0) | (self.agent >= 0) | (self.robot >= 0)
+        # the indices are >= -1, so one comparison of their maximum tells whether any is set
+        touched = np.maximum(np.maximum(self.obstacle, self.agent), self.robot) >= 0
+        return self.wall | touched
 
     @classmethod
     def none(cls, n_robots: int) -> Collisions:

@@ -245,3 +245,35 @@ def test_function_shortcuts_match_the_plain_formula():
         assert out.total.tobytes() == total.tobytes()
         assert np.array_equal(out.done, done)
         assert np.array_equal(out.reason, reason)
+
+
+@pytest.mark.parametrize("spec", ["default", "rule_13", "rlca"])
+def test_one_world_matches_each_world_of_a_batch(spec):
+    """The scalar accumulation for N = 1 gives the bits of the batched arrays, world by world."""
+    fn = RewardFunction(spec)
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        batch = make_input(
+            action=rng.normal(size=(2, 3)),
+            goal_distance=rng.random(2) * 5,
+            goal_reached=rng.random(2) < 0.3,
+            min_range=rng.random(2) * 1.5,
+            collision=rng.random(2) < 0.3,
+            step=rng.integers(495, 505, 2),
+            ped_distance=rng.random((2, 3)) * 3,
+            ped_kind=rng.integers(0, 3, (2, 3)),
+        )
+        out = fn(batch)
+        for w in range(2):
+            one = dataclasses.replace(
+                batch, **{f.name: getattr(batch, f.name)[w : w + 1]
+                          for f in dataclasses.fields(batch)}
+            )
+            single = fn(one)
+            assert single.total.tobytes() == out.total[w : w + 1].tobytes()
+            assert single.done.dtype == bool
+            assert single.reason.dtype == np.int64
+            assert single.done.tolist() == out.done[w : w + 1].tolist()
+            assert single.reason.tolist() == out.reason[w : w + 1].tolist()
+            for name, share in single.terms.items():
+                assert share.tobytes() == out.terms[name][w : w + 1].tobytes()

@@ -437,3 +437,32 @@ def test_round_limits_hold_under_random_commands():
         for kin, old, new in ((omni, so, new_o), (legged, sl, new_l)):
             assert np.all(np.abs(new.twists - old.twists) <= kin.limits().acceleration * dt + 1e-9)
         so, sl = new_o, new_l
+
+
+@pytest.mark.parametrize("kind", ["diff_drive", "omni"])
+def test_box_step_row_matches_step_bitwise(kind):
+    """The simulator's in-place row stepping gives the bits of ``Kinematics.step``."""
+    from arena.robots.kinematics.base import box_step_row
+
+    params = dict(SAMPLES[kind])
+    params.pop("speed_max", None)  # the box pipeline only: no speed disc
+    kin = build(kind, **params)
+    box = kin.box_limits
+    assert box is not None
+    rng = np.random.default_rng(0)
+    n = 4
+    poses = rng.normal(size=(n, 3)) * [5.0, 5.0, 3.0]
+    twists = rng.normal(size=(n, 3))
+    cmd = rng.normal(size=(n, 3)) * 2.0
+    cmd[0, 2] = 1e-7  # the series branch of the arc integration
+    for dt in (0.01, 0.1, 0.5):
+        ref = kin.step(KinematicState(poses, twists, np.zeros(n)), cmd, dt)
+        out_p, out_t = np.empty((n, 3)), np.empty((n, 3))
+        for i in range(n):
+            box_step_row(poses, twists, cmd, box, dt, i, out_p, out_t)
+        assert out_p.tobytes() == ref.poses.tobytes()
+        assert out_t.tobytes() == ref.twists.tobytes()
+
+
+def test_box_limits_absent_with_a_speed_disc():
+    assert build("omni", **SAMPLES["omni"]).box_limits is None

@@ -42,3 +42,26 @@ def test_hits_grid_circle_matches_dense_sampling():
         got = hits_grid(grid, fp, pose)
         if sampled:
             assert got
+
+
+def test_near_circles_matches_the_numpy_rejection_test():
+    """The compiled bounding-circle test selects exactly what ``hypot(...) <= r`` selects."""
+    from arena.sim.native2d.collisions import _near_circles
+
+    rng = np.random.default_rng(1)
+    for _ in range(300):
+        k = int(rng.integers(0, 12))
+        centers = rng.uniform(-3, 3, (k, 2))
+        radii = rng.uniform(0.1, 1.5, k)
+        x, y, r = *rng.uniform(-3, 3, 2), float(rng.uniform(0.1, 0.6))
+        ref = np.flatnonzero(np.hypot(centers[:, 0] - x, centers[:, 1] - y) <= radii + r)
+        assert _near_circles(centers, radii, x, y, r).tolist() == ref.tolist()
+
+
+def test_hits_grid_with_given_bounds_matches():
+    grid = OccupancyGrid.empty(4.0, 3.0, 0.1)
+    fp = Footprint.make(rectangle(0.5, 0.3), 0.3)
+    rng = np.random.default_rng(2)
+    for _ in range(200):
+        pose = rng.uniform([-0.5, -0.5, -np.pi], [4.5, 3.5, np.pi])
+        assert hits_grid(grid, fp, pose, bounds=grid.bounds) == hits_grid(grid, fp, pose)

@@ -233,6 +233,76 @@ def _box_kernel(
             out[i, k] = min(max(prev + d, lo), hi)
 
 
+def box_step_row(
+    poses: FloatArray,
+    twists: FloatArray,
+    commands: FloatArray,
+    box: tuple[FloatArray, FloatArray, FloatArray],
+    dt: float,
+    i: int,
+    out_poses: FloatArray,
+    out_twists: FloatArray,
+) -> None:
+    """:func:`box_step` for row ``i`` only, written into ``out_poses[i]`` and ``out_twists[i]``.
+
+    For a simulator that keeps the poses ``(r, 3)``, twists ``(r, 3)`` and commands ``(r, 3)``
+    of all its robots in C-contiguous float64 arrays and steps each robot by its own model: no
+    input checks, no intermediate arrays (the caller has validated ``commands`` and ``dt``).
+    The arithmetic is that of :func:`box_step`, so the results are bit-identical.
+
+    Args:
+        poses: ``(r, 3)`` poses ``[x m, y m, theta rad]``.
+        twists: ``(r, 3)`` executed twists of the last step ``[vx m/s, vy m/s, omega rad/s]``.
+        commands: ``(r, 3)`` desired twists, finite.
+        box: ``(lower, upper, acc)`` each ``(3,)``, a model's :attr:`box_limits`.
+        dt: step (s), finite and > 0.
+        i: the row to step.
+        out_poses: ``(r, 3)``, row ``i`` receives the new pose.
+        out_twists: ``(r, 3)``, row ``i`` receives the executed twist.
+    """
+    _box_row_kernel(poses, twists, commands, box[0], box[1], box[2], float(dt), i, out_poses,
+                    out_twists)
+
+
+@njit(cache=True)
+def _box_row_kernel(
+    poses: FloatArray,
+    twists: FloatArray,
+    cmd: FloatArray,
+    lower: FloatArray,
+    upper: FloatArray,
+    acc: FloatArray,
+    dt: float,
+    i: int,
+    out_p: FloatArray,
+    out_t: FloatArray,
+) -> None:
+    # _box_kernel then _integrate_kernel for one row, the same operations in the same order
+    for k in range(3):
+        lo, hi = lower[k], upper[k]
+        target = min(max(cmd[i, k], lo), hi)
+        prev = min(max(twists[i, k], lo), hi)
+        step = acc[k] * dt
+        d = min(max(target - prev, -step), step)
+        out_t[i, k] = min(max(prev + d, lo), hi)
+    vx, vy, om = out_t[i, 0], out_t[i, 1], out_t[i, 2]
+    phi = om * dt
+    if abs(phi) < 1e-4:
+        p2 = phi * phi
+        s = dt * (1.0 - p2 / 6.0 + p2 * p2 / 120.0)  # sin(phi)/omega
+        c = dt * phi * (0.5 - p2 / 24.0 + p2 * p2 / 720.0)  # (1 - cos phi)/omega
+    else:
+        s = math.sin(phi) / om
+        c = (1.0 - math.cos(phi)) / om
+    dxb = s * vx - c * vy
+    dyb = c * vx + s * vy
+    th = poses[i, 2]
+    ct, st = math.cos(th), math.sin(th)
+    out_p[i, 0] = poses[i, 0] + ct * dxb - st * dyb
+    out_p[i, 1] = poses[i, 1] + st * dxb + ct * dyb
+    out_p[i, 2] = (th + phi + math.pi) % (2.0 * math.pi) - math.pi
+
+
 def quadric_norm(v: FloatArray, weights: FloatArray) -> FloatArray:
     """``sqrt(Σ_i w_i v_i²)`` over the last axis: ≤ 1 inside the ellipsoid ``Σ w v² ≤ 1``."""
     norm: FloatArray = np.sqrt(np.sum(weights * v * v, axis=-1))

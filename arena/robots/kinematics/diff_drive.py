@@ -11,6 +11,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from arena.robots.kinematics.base import (
     KINEMATICS,
+    FloatArray,
     KinematicState,
     box_step,
     check_step_inputs,
@@ -59,11 +60,22 @@ class DiffDriveKinematics:
         self._lower = np.array([params.vx_min, 0.0, -params.omega_max])
         self._upper = np.array([params.vx_max, 0.0, params.omega_max])
         self._acc = np.array([params.acc_x, np.inf, params.acc_omega])
+        self._box = (self._lower, self._upper, self._acc)
 
     @property
     def holonomic(self) -> bool:
         """Always ``False``: a differential drive cannot move sideways."""
         return False
+
+    @property
+    def box_limits(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``(lower, upper, acc)`` ``(3,)`` each over ``[vx, vy, omega]`` (m/s, m/s, rad/s; /s).
+
+        :meth:`step` is exactly :func:`~arena.robots.kinematics.base.box_step` with these
+        arrays, so a simulator may call :func:`~arena.robots.kinematics.base.box_step_row`
+        instead (not to be modified).
+        """
+        return self._box
 
     def limits(self) -> VelocityLimits:
         """Box limits for planners (``vy`` and its acceleration are 0)."""

@@ -11,6 +11,7 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from arena.robots.kinematics.base import (
     KINEMATICS,
+    FloatArray,
     KinematicState,
     box_step,
     check_step_inputs,
@@ -75,11 +76,21 @@ class OmniKinematics:
         # the speed disc as a quadric on [vx, vy, omega] (omega unconstrained by it)
         s = params.speed_max
         self._disc = None if s is None else np.array([1.0 / s**2, 1.0 / s**2, 0.0])
+        self._box = None if s is not None else (self._lower, self._upper, self._acc)
 
     @property
     def holonomic(self) -> bool:
         """``True`` unless both lateral limits are 0."""
         return self.params.vy_max > 0 or self.params.vy_min < 0
+
+    @property
+    def box_limits(self) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+        """``(lower, upper, acc)`` ``(3,)`` each over ``[vx, vy, omega]`` without a speed disc.
+
+        Then :meth:`step` is exactly :func:`~arena.robots.kinematics.base.box_step` with these
+        arrays (not to be modified); ``None`` with ``speed_max`` (the disc needs more steps).
+        """
+        return self._box
 
     def limits(self) -> VelocityLimits:
         """Box limits for planners; ``speed_max`` tightens each axis limit it undercuts."""

@@ -19,7 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import SimulationError
 from arena.core.types import Pose2D
-from arena.robots.kinematics.base import KinematicState
+from arena.robots.kinematics.base import KinematicState, box_step_row
 from arena.sensors.lidar2d import Lidar2D
 from arena.sim.backend import BACKENDS, PedestrianDriver, split_rng
 from arena.sim.native2d.collisions import (
@@ -90,6 +90,7 @@ class Native2DBackend:
         """
         world = StaticWorld.build(episode.grid, episode.obstacles)
         self._world = world
+        self._grid_bounds = world.grid.bounds  # per episode, for the wall test of every step
         self._obstacles = ObstacleIndex.build(world)
         crowd_rng, self._rng = split_rng(rng)
         robots = episode.robots
@@ -98,6 +99,9 @@ class Native2DBackend:
         self._names = tuple(r.name for r in robots)
         self._models = tuple(r.model.name for r in robots)
         self._kinematics = [r.model.build_kinematics() for r in robots]
+        # Models whose whole step is the box pipeline are stepped in place by one compiled call
+        # (box_step_row), without the per-robot state objects and input checks of Kinematics.step.
+        self._boxes = [getattr(k, "box_limits", None) for k in self._kinematics]
         self._footprints = [
             Footprint.make(r.model.footprint_polygon(), r.model.circumscribed_radius)
             for r in robots
@@ -127,6 +131,10 @@ class Native2DBackend:
         else:
             self._agents = _standing_agents(episode)
         self._walked = np.zeros(len(self._agents))
+        # the distance walked only feeds the legs' gait phase: not tracked for circle bodies
+        self._track_walked = (
+            self.params.pedestrians_block_lidar and self.params.pedestrian_body == "legs"
+        )
         self._last_scan_time = [-math.inf] * n
         self._scans: list[NDArray[np.float64]] = [np.zeros(0)] * n
         collisions = self._contacts(self._poses)
@@ -144,7 +152,7 @@ class Native2DBackend:
             raise SimulationError(
                 f"commands must have shape ({n}, 3) [vx, vy, omega], got {cmd.shape}"
             )
-        if not np.all(np.isfinite(cmd)):
+        if not np.isfinite(cmd).all():
             raise SimulationError(f"commands must be finite, got {cmd.tolist()}")
         if not dt > 0:
             raise SimulationError(f"dt must be > 0 s, got {dt}")
@@ -152,13 +160,20 @@ class Native2DBackend:
         if self._driver is not None:
             before = self._agents.positions
             self._agents = self._driver.step(self._state.robots, dt)
-            if self._agents.positions.shape == before.shape:
+            if self._track_walked and self._agents.positions.shape == before.shape:
                 self._walked = self._walked + np.hypot(*(self._agents.positions - before).T)
 
         new_poses = np.empty_like(self._poses)
         new_twists = np.empty_like(self._twists)
         new_steer = np.empty_like(self._steering)
         for i, kin in enumerate(self._kinematics):
+            box = self._boxes[i]
+            if box is not None:
+                if not math.isfinite(dt):  # the check Kinematics.step would make
+                    raise SimulationError(f"dt must be a finite number > 0, got {dt!r}")
+                box_step_row(self._poses, self._twists, cmd, box, dt, i, new_poses, new_twists)
+                new_steer[i] = 0.0  # box models have no steering
+                continue
             s = kin.step(
                 KinematicState(
                     self._poses[i : i + 1], self._twists[i : i + 1], self._steering[i : i + 1]
@@ -168,8 +183,8 @@ class Native2DBackend:
             )
             new_poses[i], new_twists[i], new_steer[i] = s.poses[0], s.twists[0], s.steering[0]
 
-        collisions = self._contacts(new_poses, self._poses)
-        if self.params.collision_response == "stop":
+        collisions, touching = self._contact_flags(new_poses, self._poses)
+        if self.params.collision_response == "stop" and touching:
             blocked = collisions.any
             new_poses[blocked] = self._poses[blocked]
             new_twists[blocked] = 0.0
@@ -204,6 +219,8 @@ class Native2DBackend:
         self._poses[robot] = target
         self._twists[robot] = 0.0
         self._steering[robot] = 0.0
+        # not in place: the last snapshot holds this array (see _snapshot)
+        self._commands = self._commands.copy()
         self._commands[robot] = 0.0
         # Every robot sees the moved one (multi-robot lidar), so all scans are taken afresh.
         self._last_scan_time = [-math.inf] * n
@@ -220,24 +237,44 @@ class Native2DBackend:
         Walls are also checked along the way from ``previous``, so that a fast robot cannot
         tunnel through a thin wall in one step.
         """
+        return self._contact_flags(poses, previous)[0]
+
+    def _contact_flags(
+        self, poses: NDArray[np.float64], previous: NDArray[np.float64] | None = None
+    ) -> tuple[Collisions, bool]:
+        """:meth:`_contacts` and whether any robot touches anything (``collisions.any.any()``).
+
+        The flags are gathered in Python lists and turned into arrays once: for the usual one
+        or two robots that is cheaper than filling preallocated arrays element by element.
+        """
         world = self.world
+        grid = world.grid
         n = poses.shape[0]
-        wall = np.zeros(n, dtype=bool)
-        obstacle = np.full(n, -1, dtype=np.int64)
-        agent = np.full(n, -1, dtype=np.int64)
-        robot = np.full(n, -1, dtype=np.int64)
+        wall = [False] * n
+        obstacle = [-1] * n
+        agent = [-1] * n
+        robot = [-1] * n
+        positions, radii = self._agents.positions, self._agents.radii
         for i, fp in enumerate(self._footprints):
-            for pose in _sweep(poses[i], None if previous is None else previous[i], fp, world):
-                if hits_grid(world.grid, fp, pose):
+            pose = poses[i]
+            for p in _sweep(pose, None if previous is None else previous[i], fp, world):
+                if hits_grid(grid, fp, p, bounds=self._grid_bounds):
                     wall[i] = True
                     break
-            obstacle[i] = first_obstacle_hit(self._obstacles, fp, poses[i])
-            agent[i] = first_agent_hit(fp, poses[i], self._agents.positions, self._agents.radii)
+            obstacle[i] = first_obstacle_hit(self._obstacles, fp, pose)
+            agent[i] = first_agent_hit(fp, pose, positions, radii)
             for j in range(n):
-                if j != i and footprints_overlap(fp, poses[i], self._footprints[j], poses[j]):
+                if j != i and footprints_overlap(fp, pose, self._footprints[j], poses[j]):
                     robot[i] = j
                     break
-        return Collisions(wall, obstacle, agent, robot)
+        touching = any(wall) or max(obstacle) >= 0 or max(agent) >= 0 or max(robot) >= 0
+        collisions = Collisions(
+            np.array(wall, dtype=bool),
+            np.array(obstacle, dtype=np.int64),
+            np.array(agent, dtype=np.int64),
+            np.array(robot, dtype=np.int64),
+        )
+        return collisions, touching
 
     def _take_scans(self) -> None:
         if not self.params.lidar:
@@ -322,10 +359,13 @@ class Native2DBackend:
             models=self._models,
             poses=self._poses.copy(),
             twists=self._twists.copy(),
-            commands=self._commands.copy(),
+            # a fresh array of this step (step and teleport replace it, never write into it)
+            commands=self._commands,
             radii=self._radii.copy(),
             footprints=self._fp_polys,
-            scans=tuple(s.copy() for s in self._scans),
+            scans=(self._scans[0].copy(),)
+            if len(self._scans) == 1
+            else tuple(s.copy() for s in self._scans),
         )
         return SimState(self._time, self._step, robots, self._agents, collisions)
 

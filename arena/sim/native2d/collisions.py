@@ -53,10 +53,20 @@ class Footprint:
         return None if self.polygon is None else transform_points(self.polygon, pose)
 
 
-def hits_grid(grid: OccupancyGrid, fp: Footprint, pose: NDArray[np.float64]) -> bool:
-    """Whether the footprint at ``pose`` overlaps a blocking cell or leaves the map."""
+def hits_grid(
+    grid: OccupancyGrid,
+    fp: Footprint,
+    pose: NDArray[np.float64],
+    *,
+    bounds: tuple[float, float, float, float] | None = None,
+) -> bool:
+    """Whether the footprint at ``pose`` overlaps a blocking cell or leaves the map.
+
+    ``bounds``: ``grid.bounds`` (m) when the caller has it at hand (a simulator testing every
+    step against the same grid), to skip recomputing it.
+    """
     x, y = float(pose[0]), float(pose[1])
-    xmin, ymin, xmax, ymax = grid.bounds
+    xmin, ymin, xmax, ymax = grid.bounds if bounds is None else bounds
     if not (xmin <= x < xmax and ymin <= y < ymax):
         return True
     r = fp.radius
@@ -118,8 +128,7 @@ def first_obstacle_hit(index: ObstacleIndex, fp: Footprint, pose: NDArray[np.flo
     """Index of one obstacle the footprint at ``pose`` overlaps, or -1."""
     if not index.polygons:
         return -1
-    d = np.hypot(index.centers[:, 0] - pose[0], index.centers[:, 1] - pose[1])
-    near = np.flatnonzero(d <= index.radii + fp.radius)
+    near = _near_circles(index.centers, index.radii, float(pose[0]), float(pose[1]), fp.radius)
     if near.size == 0:
         return -1
     poly = fp.world_polygon(pose)
@@ -131,6 +140,24 @@ def first_obstacle_hit(index: ObstacleIndex, fp: Footprint, pose: NDArray[np.flo
         elif polygons_overlap(poly, ob):
             return int(j)
     return -1
+
+
+@njit(cache=True)
+def _near_circles(
+    centers: NDArray[np.float64], radii: NDArray[np.float64], x: float, y: float, radius: float
+) -> NDArray[np.int64]:
+    """Indices (ascending) of the circles ``(k, 2)``, ``(k,)`` within ``radius`` of ``(x, y)``.
+
+    ``flatnonzero(hypot(c - p) <= radii + radius)`` in one compiled call (numba's ``hypot`` is
+    the C library's, as numpy's): the rejection test runs once per robot and step.
+    """
+    out = np.empty(centers.shape[0], dtype=np.int64)
+    k = 0
+    for j in range(centers.shape[0]):
+        if math.hypot(centers[j, 0] - x, centers[j, 1] - y) <= radii[j] + radius:
+            out[k] = j
+            k += 1
+    return out[:k]
 
 
 def first_agent_hit(
