@@ -34,6 +34,9 @@ def integrate(
     vmax: FloatArray,
     clearance: FloatArray,
     dt: float,
+    *,
+    vmax_factor: FloatArray | None = None,
+    clearance_scale: float = 1.0,
 ) -> tuple[FloatArray, FloatArray]:
     """One compiled step for all agents: velocity update, speed cap, move, wall guard.
 
@@ -52,20 +55,26 @@ def integrate(
         vmax: ``(n,)`` speed caps (m/s).
         clearance: ``(n,)`` minimum centre-to-wall distance (m).
         dt: s.
+        vmax_factor: ``(n,)`` optional factors on ``vmax`` (the cap is ``vmax · vmax_factor``,
+            formed in the kernel: the same bits as multiplying first).
+        clearance_scale: factor on ``clearance`` (likewise).
 
     Returns:
         ``(positions, velocities)`` after the step; the velocity is the displacement over ``dt``
         (so sliding along a wall is what the next step starts from).
     """
     cl = walls._cells
-    return _integrate(
+    moved: tuple[FloatArray, FloatArray] = _integrate(
         np.ascontiguousarray(positions, dtype=np.float64),
         np.ascontiguousarray(velocities, dtype=np.float64),
         np.ascontiguousarray(update, dtype=np.float64),
         update_is_velocity,
         np.ascontiguousarray(active),
         np.ascontiguousarray(vmax, dtype=np.float64),
+        np.ascontiguousarray(vmax if vmax_factor is None else vmax_factor, dtype=np.float64),
+        vmax_factor is not None,
         np.ascontiguousarray(clearance, dtype=np.float64),
+        float(clearance_scale),
         float(dt),
         clearance_map,
         float(grid_origin[0]),
@@ -83,40 +92,43 @@ def integrate(
         int(cl.shape[1]),
         float(walls.half),
     )
+    return moved
 
 
 @njit(cache=True)
 def _integrate(
-    pos,
-    vel,
-    update,
-    is_velocity,
-    active,
-    vmax,
-    clearance,
-    dt,
-    cmap,
-    gox,
-    goy,
-    res,
-    wa,
-    wb,
-    mids,
-    order,
-    starts,
-    cox,
-    coy,
-    cell,
-    nx,
-    ny,
-    half,
-):
+    pos: FloatArray,
+    vel: FloatArray,
+    update: FloatArray,
+    is_velocity: bool,
+    active: NDArray[np.bool_],
+    vmax: FloatArray,
+    vmax_factor: FloatArray,
+    has_factor: bool,
+    clearance: FloatArray,
+    clearance_scale: float,
+    dt: float,
+    cmap: FloatArray,
+    gox: float,
+    goy: float,
+    res: float,
+    wa: FloatArray,
+    wb: FloatArray,
+    mids: FloatArray,
+    order: NDArray[np.int64],
+    starts: NDArray[np.int64],
+    cox: float,
+    coy: float,
+    cell: float,
+    nx: int,
+    ny: int,
+    half: float,
+) -> tuple[FloatArray, FloatArray]:
     n = pos.shape[0]
     h, w = cmap.shape
     new_p = np.empty_like(pos)
     new_v = np.empty_like(vel)
     cand = np.empty(max(wa.shape[0], 1), dtype=np.int64)
-    indptr = np.zeros(2, dtype=np.int64)
     for i in range(n):
         if not active[i]:
             new_p[i, 0], new_p[i, 1] = pos[i, 0], pos[i, 1]
@@ -127,13 +139,15 @@ def _integrate(
         else:
             vx, vy = vel[i, 0] + update[i, 0] * dt, vel[i, 1] + update[i, 1] * dt
         sp = math.sqrt(vx * vx + vy * vy)
-        if sp > vmax[i]:
-            k = vmax[i] / max(sp, 1e-12)
+        cap = vmax[i] * vmax_factor[i] if has_factor else vmax[i]
+        if sp > cap:
+            k = cap / max(sp, 1e-12)
             vx, vy = vx * k, vy * k
-            sp = vmax[i]
+            sp = cap
         x0, y0 = pos[i, 0], pos[i, 1]
         x1, y1 = x0 + vx * dt, y0 + vy * dt
         step = sp * dt
+        clear = clearance_scale * clearance[i]
         # Fast path: clearly far from every wall (a point of the cell lies within half a
         # diagonal of its centre; the map is centre-to-edge already).
         col = int((x0 - gox) // res)
@@ -141,13 +155,13 @@ def _integrate(
         bound = 0.0
         if 0 <= row < h and 0 <= col < w:
             bound = cmap[row, col] - 0.75 * res
-        if bound > step + clearance[i] or wa.shape[0] == 0:
+        if bound > step + clear or wa.shape[0] == 0:
             new_p[i, 0], new_p[i, 1] = x1, y1
             new_v[i, 0], new_v[i, 1] = vx, vy
             continue
         # Exact test against the wall pieces near the move.
         mx, my = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-        reach = 0.5 * step + clearance[i] + half + 1e-9
+        reach = 0.5 * step + clear + half + 1e-9
         rings = max(1, math.ceil(reach / cell))
         ccx = int((mx - cox) // cell)
         ccy = int((my - coy) // cell)
@@ -161,15 +175,9 @@ def _integrate(
                     if (mids[j, 0] - mx) ** 2 + (mids[j, 1] - my) ** 2 < r2:
                         cand[m] = j
                         m += 1
-        indptr[1] = m
-        p0 = np.empty((1, 2))
-        p1 = np.empty((1, 2))
-        p0[0, 0], p0[0, 1], p1[0, 0], p1[0, 1] = x0, y0, x1, y1
-        cl = np.empty(1)
-        cl[0] = clearance[i]
-        g = _guard(p0, p1, cl, wa, wb, indptr, cand[:m])
-        new_p[i, 0], new_p[i, 1] = g[0, 0], g[0, 1]
-        new_v[i, 0], new_v[i, 1] = (g[0, 0] - x0) / dt, (g[0, 1] - y0) / dt
+        qx, qy = _guard_one(x0, y0, x1, y1, clear, wa, wb, cand, 0, m)
+        new_p[i, 0], new_p[i, 1] = qx, qy
+        new_v[i, 0], new_v[i, 1] = (qx - x0) / dt, (qy - y0) / dt
     return new_p, new_v
 
 
@@ -208,7 +216,7 @@ def guard_walls(
     mid = 0.5 * (p0 + p1)
     reach = float(np.max(0.5 * step + clearance)) + 1e-9
     cand = walls.query(mid, reach)
-    return _guard(
+    guarded: FloatArray = _guard(
         np.ascontiguousarray(p0),
         np.ascontiguousarray(p1),
         np.ascontiguousarray(clearance),
@@ -217,61 +225,90 @@ def guard_walls(
         cand.indptr,
         cand.indices,
     )
+    return guarded
 
 
 @njit(cache=True)
-def _guard(p0, p1, clearance, a, b, indptr, indices):
+def _guard(
+    p0: FloatArray,
+    p1: FloatArray,
+    clearance: FloatArray,
+    a: FloatArray,
+    b: FloatArray,
+    indptr: NDArray[np.int64],
+    indices: NDArray[np.int64],
+) -> FloatArray:
     out = p1.copy()
     for i in range(p0.shape[0]):
-        x0, y0 = p0[i, 0], p0[i, 1]
-        x1, y1 = out[i, 0], out[i, 1]
-        # 1. Stop short of the first wall the move would cross.
-        dx, dy = x1 - x0, y1 - y0
-        t_hit = 1.0
-        for k in range(indptr[i], indptr[i + 1]):
-            j = indices[k]
-            ex, ey = b[j, 0] - a[j, 0], b[j, 1] - a[j, 1]
-            den = dx * ey - dy * ex
-            if abs(den) < 1e-15:
-                continue
-            wx, wy = a[j, 0] - x0, a[j, 1] - y0
-            t = (wx * ey - wy * ex) / den
-            u = (wx * dy - wy * dx) / den
-            if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0 and t < t_hit:
-                t_hit = t
-        if t_hit < 1.0:
-            t_hit = max(t_hit - 1e-3, 0.0)
-            x1, y1 = x0 + t_hit * dx, y0 + t_hit * dy
-        # 2. Keep the clearance: push out along the normal of every wall that is too close.
-        c = clearance[i]
-        for _ in range(3):  # corners need more than one push; three settle every case tested
-            moved = False
-            for k in range(indptr[i], indptr[i + 1]):
-                j = indices[k]
-                ax, ay = a[j, 0], a[j, 1]
-                ex, ey = b[j, 0] - ax, b[j, 1] - ay
-                ee = ex * ex + ey * ey
-                t = ((x1 - ax) * ex + (y1 - ay) * ey) / ee if ee > 0.0 else 0.0
-                t = min(max(t, 0.0), 1.0)
-                cx, cy = ax + t * ex, ay + t * ey
-                nx, ny = x1 - cx, y1 - cy
-                d = math.sqrt(nx * nx + ny * ny)
-                if d >= c:
-                    continue
-                if d < 1e-12:
-                    # On the wall line: push toward the side the agent came from.
-                    nx, ny = -ey, ex
-                    if (x0 - ax) * nx + (y0 - ay) * ny < 0.0:
-                        nx, ny = -nx, -ny
-                    d = 0.0
-                    norm = math.sqrt(nx * nx + ny * ny)
-                    nx, ny = nx / norm, ny / norm
-                else:
-                    nx, ny = nx / d, ny / d
-                x1 += nx * (c - d)
-                y1 += ny * (c - d)
-                moved = True
-            if not moved:
-                break
-        out[i, 0], out[i, 1] = x1, y1
+        x0, y0, x1, y1 = p0[i, 0], p0[i, 1], p1[i, 0], p1[i, 1]
+        lo, hi = indptr[i], indptr[i + 1]
+        out[i, 0], out[i, 1] = _guard_one(x0, y0, x1, y1, clearance[i], a, b, indices, lo, hi)
     return out
+
+
+@njit(cache=True)
+def _guard_one(
+    x0: float,
+    y0: float,
+    x1: float,
+    y1: float,
+    c: float,
+    a: FloatArray,
+    b: FloatArray,
+    indices: NDArray[np.int64],
+    lo: int,
+    hi: int,
+) -> tuple[float, float]:
+    """The guarded end point of one move ``(x0, y0) → (x1, y1)`` (m).
+
+    Against the segments ``a[j] → b[j]`` for ``j`` in ``indices[lo:hi]``, keeping clearance
+    ``c`` (m). Returns ``(x, y)``.
+    """
+    # 1. Stop short of the first wall the move would cross.
+    dx, dy = x1 - x0, y1 - y0
+    t_hit = 1.0
+    for k in range(lo, hi):
+        j = indices[k]
+        ex, ey = b[j, 0] - a[j, 0], b[j, 1] - a[j, 1]
+        den = dx * ey - dy * ex
+        if abs(den) < 1e-15:
+            continue
+        wx, wy = a[j, 0] - x0, a[j, 1] - y0
+        t = (wx * ey - wy * ex) / den
+        u = (wx * dy - wy * dx) / den
+        if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0 and t < t_hit:
+            t_hit = t
+    if t_hit < 1.0:
+        t_hit = max(t_hit - 1e-3, 0.0)
+        x1, y1 = x0 + t_hit * dx, y0 + t_hit * dy
+    # 2. Keep the clearance: push out along the normal of every wall that is too close.
+    for _ in range(3):  # corners need more than one push; three settle every case tested
+        moved = False
+        for k in range(lo, hi):
+            j = indices[k]
+            ax, ay = a[j, 0], a[j, 1]
+            ex, ey = b[j, 0] - ax, b[j, 1] - ay
+            ee = ex * ex + ey * ey
+            t = ((x1 - ax) * ex + (y1 - ay) * ey) / ee if ee > 0.0 else 0.0
+            t = min(max(t, 0.0), 1.0)
+            cx, cy = ax + t * ex, ay + t * ey
+            nx, ny = x1 - cx, y1 - cy
+            d = math.sqrt(nx * nx + ny * ny)
+            if d >= c:
+                continue
+            if d < 1e-12:
+                # On the wall line: push toward the side the agent came from.
+                nx, ny = -ey, ex
+                if (x0 - ax) * nx + (y0 - ay) * ny < 0.0:
+                    nx, ny = -nx, -ny
+                d = 0.0
+                norm = math.sqrt(nx * nx + ny * ny)
+                nx, ny = nx / norm, ny / norm
+            else:
+                nx, ny = nx / d, ny / d
+            x1 += nx * (c - d)
+            y1 += ny * (c - d)
+            moved = True
+        if not moved:
+            break
+    return x1, y1

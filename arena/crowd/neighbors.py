@@ -151,6 +151,27 @@ class CellList:
         self.shape = (nx, ny)
         self.order, self.starts = _build(pts, lo[0], lo[1], cell, nx, ny)
 
+    @classmethod
+    def _of_copy(cls, pts: FloatArray, cell_size: float) -> CellList:
+        """``CellList(pts, cell_size)`` in one compiled call, for the per-step searches.
+
+        ``pts``: ``(n ≥ 1, 2)`` C-contiguous float64 that the list may keep (a copy). Points
+        that are not finite, or spread over more than 2³¹ cells, take the constructor's path
+        (and its errors).
+        """
+        grid = _grid(pts, max(float(cell_size), 1e-6), _MAX_CELLS)
+        if grid is None:
+            return cls(pts, cell_size)
+        lo, cell, nx, ny, order, starts = grid
+        cl = cls.__new__(cls)
+        cl.points = pts
+        cl.origin = lo
+        cl.cell = cell
+        cl.shape = (nx, ny)
+        cl.order = order
+        cl.starts = starts
+        return cl
+
     def query(self, queries: FloatArray, radius: float, *, exclude_self: bool = False) -> Neighbors:
         """Indices of the points strictly within ``radius`` of each query.
 
@@ -194,7 +215,7 @@ def find_neighbors(positions: FloatArray, cutoff: float) -> Neighbors:
     # Half-cutoff cells scan 25 quarter-size cells (6.25 cutoff²) instead of 9 full ones (9).
     # A copy: the lists are computed when first read, and the caller may move its agents.
     pts = np.array(positions, dtype=np.float64).reshape(-1, 2)
-    return Neighbors._deferred(CellList(pts, 0.5 * cutoff), float(cutoff))
+    return Neighbors._deferred(CellList._of_copy(pts, 0.5 * cutoff), float(cutoff))
 
 
 @njit(cache=True)
@@ -214,6 +235,37 @@ def _build(
     for c in range(nx * ny):
         starts[c + 1] += starts[c]
     return order, starts
+
+
+@njit(cache=True)
+def _grid(
+    pts: FloatArray, cell: float, max_cells: int
+) -> tuple[FloatArray, float, int, int, IntArray, IntArray] | None:
+    """:class:`CellList`'s constructor for ``(n ≥ 1, 2)`` points, the same numbers.
+
+    Returns:
+        ``(origin (2,), cell, nx, ny, order, starts)``, or None for a coordinate that is not
+        finite or an extent beyond 2³¹ cells (the constructor's Python integers handle those).
+    """
+    lo = pts[0].copy()
+    hi = pts[0].copy()
+    for i in range(pts.shape[0]):
+        for d in range(2):
+            v = pts[i, d]
+            if not math.isfinite(v):
+                return None
+            lo[d] = min(lo[d], v)
+            hi[d] = max(hi[d], v)
+    if (hi[0] - lo[0]) / cell > 2.0**31 or (hi[1] - lo[1]) / cell > 2.0**31:
+        return None  # nx · ny could overflow int64
+    nx = math.floor((hi[0] - lo[0]) / cell) + 1
+    ny = math.floor((hi[1] - lo[1]) / cell) + 1
+    while nx * ny > max_cells:  # sparse, huge extents: coarser cells, still correct
+        cell *= 2.0
+        nx = math.floor((hi[0] - lo[0]) / cell) + 1
+        ny = math.floor((hi[1] - lo[1]) / cell) + 1
+    order, starts = _build(pts, lo[0], lo[1], cell, nx, ny)
+    return lo, cell, nx, ny, order, starts
 
 
 @njit(cache=True)

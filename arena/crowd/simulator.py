@@ -15,9 +15,11 @@ It is the native2d backend's :class:`~arena.sim.backend.PedestrianDriver`. One s
 
 from __future__ import annotations
 
+import math
 from typing import Any, Literal
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
@@ -132,7 +134,7 @@ class CrowdSimulator:
 
             self.social = SocialStates()
             self.social.reset(state, world, rng)
-        self._update_destinations(np.zeros(0, dtype=bool))
+        self._update_destinations()
         return self._snapshot()
 
     def step(self, robots: RobotStates, dt: float) -> AgentStates:
@@ -143,8 +145,7 @@ class CrowdSimulator:
             return self._snapshot()
         view = robot_view(robots)
         self._start_up(view)
-        arrived = self._advance_waypoints()
-        self._update_destinations(arrived)
+        self._advance_waypoints()
         if self.social is not None:
             self.social.pre(s, view, self._world, dt)
         active = s.started.copy()
@@ -186,13 +187,15 @@ class CrowdSimulator:
             update,
             self.model.output == "velocity",
             active,
-            s.vmax * s.vmax_factor,  # after post: it may lower the factors
-            self.config.wall_clearance * s.radii,
+            s.vmax,
+            s.radii,
             dt,
+            vmax_factor=s.vmax_factor,  # after post: it may lower the factors
+            clearance_scale=self.config.wall_clearance,
         )
         s.velocities = v
-        moving = np.hypot(v[:, 0], v[:, 1]) > 1e-3
-        s.headings = np.where(moving, np.arctan2(v[:, 1], v[:, 0]), s.headings)
+        # NumPy's arctan2 on these strided views, as always (its SIMD and scalar paths differ).
+        s.headings = _face_motion(v, np.arctan2(v[:, 1], v[:, 0]), s.headings)
         if self.social is not None:
             self.social.orient(s)
         s.forces = out.forces
@@ -202,9 +205,9 @@ class CrowdSimulator:
     # -- steps ----------------------------------------------------------------------------------
     def _start_up(self, robots: RobotView) -> None:
         s = self.state
-        waiting = ~s.started
-        if not waiting.any():
+        if s.started.all():  # the common case once every agent has started
             return
+        waiting = ~s.started
         timer = waiting & (s.startup_mode == StartupMode.WAIT_TIMER) & (s.time >= s.wait_time)
         trigger = np.zeros_like(waiting)
         zone = waiting & (s.startup_mode == StartupMode.TRIGGER_ZONE)
@@ -215,30 +218,42 @@ class CrowdSimulator:
             trigger[zone] = np.any(d <= s.trigger_radius[zone, None], axis=1)
         s.started = s.started | timer | trigger
 
-    def _advance_waypoints(self) -> NDArray[np.bool_]:
-        """Tolerant switch: leaders and loners within tolerance of their waypoint take the next."""
-        s = self.state
-        own = s.leader == self._rows
-        target = s.waypoints[self._rows, s.waypoint_index]
-        tol = np.maximum(self.config.waypoint_tolerance, s.radii)
-        arrived = own & s.started & (np.hypot(*(s.positions - target).T) < tol)
-        if arrived.any():
-            nwp = s.num_waypoints
-            nxt = (s.waypoint_index + 1) % nwp
-            rand = arrived & (s.waypoint_mode == WAYPOINT_RANDOM) & (nwp > 1)
-            if rand.any():
-                shift = self._rng.integers(1, nwp[rand])
-                nxt[rand] = (s.waypoint_index[rand] + shift) % nwp[rand]
-            s.waypoint_index = np.where(arrived, nxt, s.waypoint_index)
-        return arrived
+    def _advance_waypoints(self) -> None:
+        """Tolerant switch, then destinations (see :meth:`_update_destinations`).
 
-    def _update_destinations(self, arrived: NDArray[np.bool_]) -> None:
+        Leaders and loners within tolerance of their waypoint take the next. Usually nobody
+        arrives, and the destinations computed with the arrival test stand.
+        """
+        s = self.state
+        arrived, dest = _arrivals(
+            s.positions,
+            s.waypoints,
+            s.waypoint_index,
+            s.leader,
+            s.started,
+            s.radii,
+            self.config.waypoint_tolerance,
+            self._members,
+            self._offsets,
+        )
+        if not arrived.any():
+            s.destinations = dest
+            return
+        nwp = s.num_waypoints
+        nxt = (s.waypoint_index + 1) % nwp
+        rand = arrived & (s.waypoint_mode == WAYPOINT_RANDOM) & (nwp > 1)
+        if rand.any():
+            shift = self._rng.integers(1, nwp[rand])
+            nxt[rand] = (s.waypoint_index[rand] + shift) % nwp[rand]
+        s.waypoint_index = np.where(arrived, nxt, s.waypoint_index)
+        self._update_destinations()
+
+    def _update_destinations(self) -> None:
         """Own waypoint for leaders and loners; the leader's, offset on a ring, for members."""
         s = self.state
-        wp = s.waypoints[self._rows, s.waypoint_index]
-        if self._members.size:
-            wp[self._members] = wp[s.leader[self._members]] + self._offsets
-        s.destinations = wp
+        s.destinations = _destinations(
+            s.waypoints, s.waypoint_index, s.leader, self._members, self._offsets
+        )
 
     @staticmethod
     def _ring_offsets(rank: NDArray[np.int64], spacing: float) -> FloatArray:
@@ -301,10 +316,139 @@ def robot_view(robots: RobotStates) -> RobotView:
     if len(robots) == 0:
         return RobotView.empty()
     th = robots.poses[:, 2]
-    c, s = np.cos(th), np.sin(th)
-    vx, vy = robots.twists[:, 0], robots.twists[:, 1]
-    vel = np.stack([c * vx - s * vy, s * vx + c * vy], axis=1)
-    return RobotView(robots.poses[:, :2].copy(), th.copy(), vel, robots.radii.copy())
+    # NumPy's cos and sin (their SIMD results are what the crowd has always seen); the
+    # rotation, and copies of the poses, in one compiled call.
+    cos, sin = np.cos(th), np.sin(th)
+    return RobotView(*_robot_frame(robots.poses, robots.twists, robots.radii, cos, sin))
+
+
+@njit(cache=True)
+def _robot_frame(
+    poses: FloatArray, twists: FloatArray, radii: FloatArray, cos: FloatArray, sin: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Robot positions, headings and world-frame velocities from poses and body-frame twists.
+
+    Args:
+        poses: ``(r, 3)`` ``(x, y, θ)`` (m, rad).
+        twists: ``(r, ≥ 2)`` body-frame velocities (m/s).
+        radii: ``(r,)`` m.
+        cos: ``(r,)`` ``cos θ``.
+        sin: ``(r,)`` ``sin θ``.
+
+    Returns:
+        ``(positions (r, 2) m, headings (r,) rad, velocities (r, 2) m/s, radii (r,) m)``, fresh
+        arrays (the :class:`RobotView` fields in order).
+    """
+    r = poses.shape[0]
+    pos = np.empty((r, 2))
+    heading = np.empty(r)
+    vel = np.empty((r, 2))
+    for k in range(r):
+        pos[k, 0] = poses[k, 0]
+        pos[k, 1] = poses[k, 1]
+        heading[k] = poses[k, 2]
+        vx = twists[k, 0]
+        vy = twists[k, 1]
+        vel[k, 0] = cos[k] * vx - sin[k] * vy
+        vel[k, 1] = sin[k] * vx + cos[k] * vy
+    return pos, heading, vel, radii.copy()
+
+
+@njit(cache=True)
+def _arrivals(
+    positions: FloatArray,
+    waypoints: FloatArray,
+    waypoint_index: NDArray[np.int64],
+    leader: NDArray[np.int64],
+    started: NDArray[np.bool_],
+    radii: FloatArray,
+    tolerance: float,
+    members: NDArray[np.int64],
+    offsets: FloatArray,
+) -> tuple[NDArray[np.bool_], FloatArray]:
+    """Leaders and loners that have reached their waypoint, and :func:`_destinations`.
+
+    Reached: started and within ``max(tolerance, radius)`` (m) of the waypoint; ``hypot`` is
+    libm's, as NumPy's, so the test is the NumPy expression's to the bit.
+
+    Args:
+        positions: ``(n, 2)`` m.
+        waypoints: ``(n, K, 2)`` m.
+        waypoint_index: ``(n,)`` the waypoint each agent walks to.
+        leader: ``(n,)`` group leader index (itself for leaders and loners).
+        started: ``(n,)`` bool.
+        radii: ``(n,)`` m.
+        tolerance: m.
+        members: ``(g,)`` the agents that follow a leader.
+        offsets: ``(g, 2)`` their ring offsets (m).
+
+    Returns:
+        ``(arrived (n,) bool, destinations (n, 2) m)``, the destinations for the current
+        waypoints (stale for the agents that arrived).
+    """
+    n = positions.shape[0]
+    arrived = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        if leader[i] != i or not started[i]:
+            continue
+        k = waypoint_index[i]
+        r = radii[i]
+        tol = r if (r > tolerance or r != r) else tolerance  # np.maximum: NaN wins
+        d = math.hypot(positions[i, 0] - waypoints[i, k, 0], positions[i, 1] - waypoints[i, k, 1])
+        arrived[i] = d < tol
+    return arrived, _destinations(waypoints, waypoint_index, leader, members, offsets)
+
+
+@njit(cache=True)
+def _destinations(
+    waypoints: FloatArray,
+    waypoint_index: NDArray[np.int64],
+    leader: NDArray[np.int64],
+    members: NDArray[np.int64],
+    offsets: FloatArray,
+) -> FloatArray:
+    """Each agent's current waypoint; group members take their leader's plus a ring offset.
+
+    Args:
+        waypoints: ``(n, K, 2)`` m.
+        waypoint_index: ``(n,)``.
+        leader: ``(n,)`` group leader index.
+        members: ``(g,)`` the agents that follow a leader.
+        offsets: ``(g, 2)`` their ring offsets (m).
+
+    Returns:
+        ``(n, 2)`` m, a fresh array.
+    """
+    n = waypoints.shape[0]
+    dest = np.empty((n, 2))
+    for i in range(n):
+        k = waypoint_index[i]
+        dest[i, 0] = waypoints[i, k, 0]
+        dest[i, 1] = waypoints[i, k, 1]
+    for q in range(members.shape[0]):  # leaders are never members: their rows are final
+        m = members[q]
+        dest[m, 0] = dest[leader[m], 0] + offsets[q, 0]
+        dest[m, 1] = dest[leader[m], 1] + offsets[q, 1]
+    return dest
+
+
+@njit(cache=True)
+def _face_motion(velocities: FloatArray, angles: FloatArray, headings: FloatArray) -> FloatArray:
+    """Headings after a step: the motion's direction for agents faster than 1 mm/s.
+
+    Args:
+        velocities: ``(n, 2)`` m/s.
+        angles: ``(n,)`` their directions (rad).
+        headings: ``(n,)`` the previous headings (rad).
+
+    Returns:
+        ``(n,)`` rad, a fresh array.
+    """
+    out = np.empty(headings.shape[0])
+    for i in range(out.shape[0]):
+        moving = math.hypot(velocities[i, 0], velocities[i, 1]) > 1e-3  # libm's, as NumPy's
+        out[i] = angles[i] if moving else headings[i]
+    return out
 
 
 def form_groups(

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -180,7 +180,9 @@ class CrowdState:
 
     def copy(self) -> CrowdState:
         """A deep copy (for tests and counterfactual replays)."""
-        kw = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()}
+        kw: dict[str, Any] = {
+            k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()
+        }
         kw["forces"] = {k: v.copy() for k, v in self.forces.items()}
         return CrowdState(**kw)
 

@@ -101,3 +101,24 @@ def test_neighbors_are_read_only() -> None:
         nb.indptr = np.zeros(11, dtype=np.int64)  # type: ignore[misc]
     with pytest.raises(AttributeError):
         nb.cutoff = 2.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize(("n", "scale", "cell"), [(1, 1.0, 1.0), (7, 1e-3, 0.01), (300, 30.0, 5.0)])
+def test_compiled_cell_list_is_the_constructors(n: int, scale: float, cell: float) -> None:
+    pts = np.random.default_rng(n).normal(0.0, scale, (n, 2))
+    pts[-1] = pts[0]  # a repeated point
+    want = CellList(pts, cell)
+    got = CellList._of_copy(pts.copy(), cell)
+    assert got.origin.tobytes() == want.origin.tobytes()
+    assert (got.cell, got.shape) == (want.cell, want.shape)
+    assert got.shape[0].__class__ is int and isinstance(got.cell, float)
+    np.testing.assert_array_equal(got.order, want.order)
+    np.testing.assert_array_equal(got.starts, want.starts)
+
+
+def test_compiled_cell_list_leaves_odd_extents_to_the_constructor() -> None:
+    huge = CellList._of_copy(np.array([[0.0, 0.0], [1e300, 1.0]]), 1.0)  # coarsened, not overflown
+    want = CellList(np.array([[0.0, 0.0], [1e300, 1.0]]), 1.0)
+    assert (huge.cell, huge.shape) == (want.cell, want.shape)
+    with pytest.raises(ValueError, match="NaN"):
+        CellList._of_copy(np.array([[0.0, 0.0], [np.nan, 1.0]]), 1.0)

@@ -523,3 +523,95 @@ def test_no_agents_and_no_walls() -> None:
 
 def test_passes_the_crowd_model_conformance_checks() -> None:
     check_crowd_model(PySocialModel)
+
+
+# -- the compiled kernels against their plain NumPy / Python formulations (to the bit) ----------
+def test_desired_kernel_is_desired_force_to_the_bit() -> None:
+    from arena.crowd.models.pysocial import _desired, desired_force
+
+    rng = np.random.default_rng(11)
+    n = 200
+    pos = rng.uniform(0, 10, (n, 2))
+    vel = rng.normal(0, 1, (n, 2))
+    dest = rng.uniform(0, 10, (n, 2))
+    dest[:20] = pos[:20] + rng.uniform(-0.1, 0.1, (20, 2))  # inside the goal threshold: brake
+    dest[20:25] = pos[20:25]  # on the destination
+    vmax, factor = rng.uniform(0.3, 1.5, n), rng.choice([0.0, 0.5, 1.0], n)
+    out = np.empty((n, 2))
+    for tau, threshold in ((0.5, 0.2), (0.3, 0.0)):
+        _desired(pos, vel, dest, vmax, factor, tau, threshold, out)
+        want = desired_force(pos, vel, dest, vmax * factor, tau, threshold)
+        assert out.tobytes() == want.tobytes()
+
+
+def plain_obstacle_sum(
+    pos: np.ndarray, radii: np.ndarray, points: np.ndarray, threshold: float, sigma: float
+) -> np.ndarray:
+    """PySocialForce's obstacle sum per agent, point by point in ``points``' order (Python)."""
+    out = np.zeros((len(pos), 2))
+    for i, (x, y) in enumerate(pos.tolist()):
+        r = float(radii[i])
+        thr = threshold + r
+        far2 = (thr + r) * (thr + r) * (1.0 + 1e-9)
+        fx = fy = 0.0
+        for px, py in points.tolist():
+            dx, dy = x - px, y - py
+            d2 = dx * dx + dy * dy
+            dist = math.sqrt(d2)
+            if d2 < far2 and dist - r < thr and dist > 0.0:
+                w = math.exp(-(dist - r) / sigma)
+                fx += dx / dist * w
+                fy += dy / dist * w
+        out[i] = fx, fy
+    return out
+
+
+@pytest.mark.parametrize("agent_radius", [0.35, None])
+def test_obstacle_term_is_the_plain_sum_in_cell_order_to_the_bit(
+    agent_radius: float | None,
+) -> None:
+    """Pruned cells and blocks, runs and the vectorised pass change no bit of the sum."""
+    world, state, dest = random_scene(7, 30)
+    state.radii = np.random.default_rng(7).uniform(0.2, 0.5, 30)
+    state.positions[0] = world_segments(world)[0][3]  # on a wall point: distance 0, skipped
+    model = PySocialModel(PySocialModel.Params(agent_radius=agent_radius))
+    model.reset(state, world, np.random.default_rng(0))
+    out = model.compute(make_frame(state, dest, search=10.0))
+    cells = model._cells
+    radii = state.radii if agent_radius is None else np.full(30, agent_radius)
+    p = model.params
+    want = plain_obstacle_sum(
+        state.positions, radii, cells.points[cells.order], p.obstacle_threshold, p.obstacle_sigma
+    )
+    assert out.forces["obstacle"].tobytes() == (want * p.obstacle_factor).tobytes()
+    assert np.abs(want).max() > 0
+
+
+def test_accelerations_are_the_terms_summed_in_order_to_the_bit() -> None:
+    world, state, dest = random_scene(8, 20)
+    active = np.ones(20, dtype=bool)
+    active[[2, 7]] = False
+    robots = RobotView(np.array([[6.0, 5.0]]), np.zeros(1), np.array([[0.5, 0.0]]), np.ones(1))
+    frame = make_frame(state, dest, active=active, robots=robots, search=10.0)
+    for scale in (1.0, 0.3):
+        out = ours(world, frame, force_scale=scale)
+        total = np.zeros((20, 2))
+        for name in TERMS:  # what NumPy does: 0 + desired + social + ...
+            total += out.forces[name]
+        assert out.accelerations.tobytes() == total.tobytes()
+        assert np.all(out.accelerations[~active] == 0.0)
+        assert all(np.abs(out.forces[k]).max() > 0 for k in ("social", "obstacle", "robot"))
+
+
+def test_groups_edited_in_place_are_seen() -> None:
+    world, state, dest = random_scene(9, 12)
+    model = PySocialModel()
+    model.reset(state, world, np.random.default_rng(0))
+    frame = make_frame(state, dest, search=10.0)
+    model.compute(frame)
+    state.group[:] = -1
+    state.group[[0, 1, 2]] = 5  # same array, new groups
+    again = model.compute(frame)
+    fresh = ours(world, frame)
+    for name in TERMS:
+        assert again.forces[name].tobytes() == fresh.forces[name].tobytes(), name

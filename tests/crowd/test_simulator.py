@@ -243,3 +243,79 @@ def test_grid_walls_are_cached_per_map():
     world = StaticWorld.build(OccupancyGrid.from_occupied(occ, 0.1))
     for got, want in zip(episode_segments(world), world_segments(world), strict=True):
         assert got.tobytes() == want.tobytes()
+
+
+# -- the compiled steps against the NumPy expressions they replace (to the bit) ----------------
+def test_route_kernels_are_the_numpy_expressions():
+    from arena.crowd.simulator import _arrivals, _destinations
+
+    rng = np.random.default_rng(3)
+    n, k = 50, 4
+    pos = rng.uniform(0, 10, (n, 2))
+    wps = rng.uniform(0, 10, (n, k, 2))
+    idx = rng.integers(0, k, n)
+    wps[np.arange(10), idx[:10]] = pos[:10] + rng.uniform(-0.6, 0.6, (10, 2))  # near: arrive
+    leader = np.arange(n)
+    leader[[5, 6, 30]] = [4, 4, 29]
+    members = np.flatnonzero(leader != np.arange(n))
+    offsets = rng.normal(0, 1, (members.size, 2))
+    started = rng.random(n) < 0.8
+    radii = rng.uniform(0.2, 0.7, n)
+    radii[7] = np.nan
+    arrived, dest = _arrivals(pos, wps, idx, leader, started, radii, 0.5, members, offsets)
+    rows = np.arange(n)
+    target = wps[rows, idx]
+    tol = np.maximum(0.5, radii)
+    want = (leader == rows) & started & (np.hypot(*(pos - target).T) < tol)
+    np.testing.assert_array_equal(arrived, want)
+    assert want[:10].any()
+    wp = target.copy()
+    wp[members] = wp[leader[members]] + offsets
+    assert dest.tobytes() == wp.tobytes()
+    assert _destinations(wps, idx, leader, members, offsets).tobytes() == wp.tobytes()
+
+
+def test_robot_view_and_headings_are_the_numpy_expressions():
+    from arena.crowd.simulator import _face_motion
+
+    rng = np.random.default_rng(4)
+    poses = rng.uniform(-5, 5, (3, 3))
+    twists = rng.normal(0, 1, (3, 3))
+    zeros = np.zeros((3, 3))
+    names, kinds, radii = ("a", "b", "c"), ("burger",) * 3, np.full(3, 0.2)
+    robots = RobotStates(names, kinds, poses, twists, zeros, radii, (None,) * 3, (zeros[0],) * 3)
+    view = robot_view(robots)
+    th = poses[:, 2]
+    c, s = np.cos(th), np.sin(th)
+    vx, vy = twists[:, 0], twists[:, 1]
+    want = np.stack([c * vx - s * vy, s * vx + c * vy], axis=1)
+    assert view.velocities.tobytes() == want.tobytes()
+    assert view.positions.tobytes() == poses[:, :2].copy().tobytes()
+    assert view.headings.tobytes() == th.copy().tobytes()
+    v = rng.normal(0, 1e-3, (40, 2))
+    heads = rng.uniform(-3, 3, 40)
+    angles = np.arctan2(v[:, 1], v[:, 0])
+    want_h = np.where(np.hypot(v[:, 0], v[:, 1]) > 1e-3, angles, heads)
+    assert _face_motion(v, angles, heads).tobytes() == want_h.tobytes()
+
+
+def test_integrate_factors_are_the_premultiplied_arrays():
+    from arena.crowd.integrator import integrate
+    from arena.tasks.sampling import clearance_map
+
+    occ = np.zeros((60, 60), dtype=bool)
+    occ[:, 30] = occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
+    grid = OccupancyGrid.from_occupied(occ, 0.1)
+    idx = WallIndex(*grid_wall_segments(grid))
+    rng = np.random.default_rng(8)
+    n = 200
+    pos = rng.uniform(0.3, 5.7, (n, 2))
+    vel, acc = rng.normal(0, 1, (n, 2)), rng.normal(0, 20, (n, 2))
+    vmax, factor = rng.uniform(0.5, 2, n), rng.choice([0.0, 0.5, 1.0], n)
+    radii = rng.uniform(0.1, 0.4, n)
+    active = rng.random(n) < 0.9
+    cmap = clearance_map(grid)
+    args = (idx, cmap, grid.origin, grid.resolution, pos, vel, acc, False, active)
+    got = integrate(*args, vmax, radii, 0.2, vmax_factor=factor, clearance_scale=0.8)
+    want = integrate(*args, vmax * factor, 0.8 * radii, 0.2)
+    assert got[0].tobytes() == want[0].tobytes() and got[1].tobytes() == want[1].tobytes()

@@ -117,12 +117,17 @@ accumulation, NumPy's SIMD ``arctan2`` and ``exp`` in between, about 3× faster 
 from inside a numba loop; the geometry and angle kernels are branch-free in the common case so
 that LLVM vectorises them (IEEE sqrt and division give the scalar bits), with the rare cases
 (signed zeros, coincident agents, ``Δv = 0``) redone by the scalar formula. The obstacle term
-scans the point grid directly, skipping runs of points whose bounding box is out of reach.
+scans the point grid directly, skipping cells and runs of points whose bounding box is out of
+reach, and evaluates the rest in a vectorised pass before the (libm) exponentials. Every other
+term, the factors and the total are one compiled call (:func:`_terms`) that repeats NumPy's
+element-wise arithmetic in NumPy's order, so the results are those of the term-by-term NumPy
+formulation to the bit (``tests/crowd/test_pysocial.py`` checks the kernels that way).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import ClassVar, Literal
 
 import numpy as np
@@ -257,11 +262,12 @@ class PySocialModel:
 
     def __init__(self, params: Params | None = None) -> None:
         self.params = params or self.Params()
-        self.obstacle_points: FloatArray = np.zeros((0, 2))
-        self._cells = CellList(self.obstacle_points, 1.0)
-        self._blocks = _point_blocks(self._cells.points, self._cells.order, self._cells.starts)
-        self._work: dict[str, NDArray[np.generic]] | None = None
+        self._coef_of: PySocialModel.Params | None = None
+        self._coef: FloatArray = np.zeros(len(_COEF))
+        self.set_obstacles(np.zeros((0, 2)), np.zeros((0, 2)))
+        self._work: _PairWork | None = None
         self._groups_cache: tuple[IntArray, IntArray, IntArray] | None = None
+        self._radii: FloatArray = np.zeros(0)
 
     def neighbor_cutoff(self) -> float:
         """The social interaction range ``cutoff`` (m)."""
@@ -289,106 +295,83 @@ class PySocialModel:
         p = self.params
         r = p.agent_radius if p.agent_radius is not None else max_radius
         self._cells = CellList(self.obstacle_points, p.obstacle_threshold + 2.0 * r)
-        self._blocks = _point_blocks(self._cells.points, self._cells.order, self._cells.starts)
+        self._obstacles = _ObstacleIndex.build(self._cells)
 
     def compute(self, frame: CrowdFrame) -> ModelOutput:
         """PySocialForce's forces for every active agent (zero for inactive ones)."""
         p = self.params
         s = frame.state
         n = len(s)
-        pos = np.ascontiguousarray(s.positions, dtype=np.float64)
-        vel = np.ascontiguousarray(s.velocities, dtype=np.float64)
-        dest = np.ascontiguousarray(frame.destinations, dtype=np.float64)
-        active = np.ascontiguousarray(frame.active, dtype=np.bool_)
-        terms = {k: np.zeros((n, 2)) for k in TERMS}
+        # One block for the seven terms: the kernel fills it, the dict hands out its rows.
+        forces = np.zeros((len(TERMS), n, 2))
+        terms = {k: forces[i] for i, k in enumerate(TERMS)}
         if n == 0:
             return ModelOutput(accelerations=np.zeros((0, 2)), forces=terms)
-
-        terms["desired"] = desired_force(
-            pos, vel, dest, s.vmax * s.vmax_factor, p.relaxation_time, p.goal_threshold
-        )
-        terms["desired"] *= p.desired_factor
+        pos = np.ascontiguousarray(s.positions, dtype=np.float64)
+        vel = np.ascontiguousarray(s.velocities, dtype=np.float64)
+        active = np.ascontiguousarray(frame.active, dtype=np.bool_)
 
         pi, pj = frame.neighbors.unique_pairs()
         if not active.all():  # pairs of two inactive agents exert nothing on anyone
             keep = active[pi] | active[pj]
             pi, pj = pi[keep], pj[keep]
-        self._social_term(pos, vel, pi, pj, terms["social"])
-        terms["social"] *= p.social_factor
+        self._social_term(pos, vel, pi, pj, forces[_SOCIAL])
 
-        if len(frame.robots) and p.robot_factor > 0.0:
-            _robots(
-                pos,
-                vel,
-                active,
-                np.ascontiguousarray(frame.robots.positions, dtype=np.float64),
-                np.ascontiguousarray(frame.robots.velocities, dtype=np.float64),
-                float(p.cutoff),
-                p.lambda_importance,
-                p.gamma,
-                p.n,
-                p.n_prime,
-                p.wrap_theta,
-                terms["robot"],
-            )
-            terms["robot"] *= p.robot_factor * p.social_factor
-
-        if self.obstacle_points.shape[0]:
-            radii = (
-                np.full(n, float(p.agent_radius))
-                if p.agent_radius is not None
-                else np.ascontiguousarray(s.radii, dtype=np.float64)
-            )
-            cells = self._cells
-            _obstacle(
-                pos,
-                radii,
-                active,
-                cells.points,
-                cells.order,
-                *self._blocks,
-                float(cells.origin[0]),
-                float(cells.origin[1]),
-                float(cells.cell),
-                int(cells.shape[0]),
-                int(cells.shape[1]),
-                # Slightly wider than the reach: the kernel applies PySocialForce's exact test.
-                p.obstacle_threshold + 2.0 * float(radii.max()) + 1e-9,
-                p.obstacle_threshold,
-                p.obstacle_sigma,
-                terms["obstacle"],
-            )
-            terms["obstacle"] *= p.obstacle_factor
-
-        if p.enable_group:
-            order, starts = self._group_members(s.group)
-            if starts.shape[0] > 1:
-                _groups(
-                    pos,
-                    dest,
-                    active,
-                    order,
-                    starts,
-                    p.group_repulsion_threshold,
-                    p.coherence_uses_distance,
-                    terms["group_coherence"],
-                    terms["group_repulsion"],
-                    terms["group_gaze"],
-                )
-                terms["group_coherence"] *= p.group_coherence_factor
-                terms["group_repulsion"] *= p.group_repulsion_factor
-                terms["group_gaze"] *= p.group_gaze_factor
-
-        acc = np.zeros((n, 2))
-        inactive = None if active.all() else ~active
-        for k in TERMS:
-            f = terms[k]
-            if inactive is not None:
-                f[inactive] = 0.0
-            if p.force_scale != 1.0:
-                f *= p.force_scale
-            acc += f
+        radii = self._agent_radii(s)
+        r_max = float(p.agent_radius) if p.agent_radius is not None else float(radii.max())
+        order, starts = self._group_members(s.group) if p.enable_group else _NO_GROUPS
+        ob = self._obstacles
+        acc = np.empty((n, 2))
+        _terms(
+            pos,
+            vel,
+            np.ascontiguousarray(frame.destinations, dtype=np.float64),
+            np.ascontiguousarray(s.vmax, dtype=np.float64),
+            np.ascontiguousarray(s.vmax_factor, dtype=np.float64),
+            active,
+            np.ascontiguousarray(frame.robots.positions, dtype=np.float64),
+            np.ascontiguousarray(frame.robots.velocities, dtype=np.float64),
+            radii,
+            # Slightly wider than the reach: the kernel applies PySocialForce's exact test.
+            p.obstacle_threshold + 2.0 * r_max + 1e-9,
+            ob.xy,
+            ob.cell_blocks,
+            ob.block_lo,
+            ob.bbox,
+            ob.cell_box,
+            ob.grid,
+            ob.shape,
+            ob.work,
+            order,
+            starts,
+            self._coefficients(),
+            p.wrap_theta,
+            p.coherence_uses_distance,
+            forces,
+            acc,
+        )
         return ModelOutput(accelerations=acc, forces=terms)
+
+    def _coefficients(self) -> FloatArray:
+        """The parameters as the kernel reads them (:data:`_COEF` order), rebuilt if replaced."""
+        if self._coef_of is not self.params:
+            p = self.params
+            values = {k: float(getattr(p, k)) for k in _COEF if hasattr(p, k)}
+            # The robot term's factor, formed first and then applied, as it always was.
+            values["robot_scale"] = p.robot_factor * p.social_factor
+            self._coef = np.array([values[k] for k in _COEF])
+            self._coef_of = p
+        return self._coef
+
+    def _agent_radii(self, state: CrowdState) -> FloatArray:
+        """``(n,)`` the radius each agent has in the obstacle term (m)."""
+        r = self.params.agent_radius
+        if r is None:
+            return np.ascontiguousarray(state.radii, dtype=np.float64)
+        n = len(state)
+        if self._radii.shape[0] != n or self._radii[0] != r:  # one scene-wide radius: cached
+            self._radii = np.full(n, float(r))
+        return self._radii
 
     def _group_members(self, group: IntArray) -> tuple[IntArray, IntArray]:
         """:func:`group_members` of ``group``, recomputed only when the groups change.
@@ -396,10 +379,10 @@ class PySocialModel:
         Groups are fixed for an episode, so the copy compared here nearly always matches.
         """
         cached = self._groups_cache
-        if cached is not None and np.array_equal(cached[0], group):
+        if cached is not None and _same_ints(cached[0], np.ascontiguousarray(group)):
             return cached[1], cached[2]
         order, starts = group_members(group)
-        self._groups_cache = (np.array(group, copy=True), order, starts)
+        self._groups_cache = (np.array(group, dtype=np.int64, copy=True), order, starts)
         return order, starts
 
     def _social_term(
@@ -424,24 +407,8 @@ class PySocialModel:
             return
         # Work arrays live across steps: fresh large arrays would page-fault every step.
         k = min(m, _CHUNK)
-        if self._work is None or self._work["sn"].shape[0] < k:
-            # The geometry rows share one array: the vectorised kernel needs few base pointers.
-            geo = np.empty((6, k))
-            self._work = {
-                "gather": np.empty((4, k)),
-                "geo": geo,
-                "sn": geo[0],
-                "cs": geo[1],
-                "base": geo[2],
-                "bb": geo[3],
-                "tx": geo[4],
-                "ty": geo[5],
-                "code": np.empty(k, dtype=np.int64),
-                "w": np.empty(k),
-                "args": np.empty((4, k)),
-                "ex": np.empty((4, k)),
-                "sg": np.empty((2, k)),
-            }
+        if self._work is None or self._work.w.shape[0] < k:
+            self._work = _PairWork.allocate(k)
         wk = self._work
         for lo in range(0, m, _CHUNK):  # a few blocks per step; the per-pair work is compiled
             hi = min(lo + _CHUNK, m)
@@ -456,25 +423,144 @@ class PySocialModel:
                 float(p.cutoff),
                 p.lambda_importance,
                 p.gamma,
-                wk["gather"],
-                wk["geo"],
-                wk["code"],
+                wk.gather,
+                wk.geo,
+                wk.code,
             )
-            np.arctan2(wk["sn"][:c], wk["cs"][:c], out=wk["w"][:c])
-            _pair_exponents(
-                wk["w"],
-                wk["code"],
-                wk["geo"],
-                c,
-                p.n,
-                p.n_prime,
-                p.wrap_theta,
-                wk["args"],
-                wk["sg"],
-            )
+            geo = wk.geo
+            np.arctan2(geo[0, :c], geo[1, :c], out=wk.w[:c])
+            args = wk.args[: 4 * c].reshape(4, c)
+            ex = wk.ex[: 4 * c].reshape(4, c)
+            _pair_exponents(wk.w, wk.code, geo, c, p.n, p.n_prime, p.wrap_theta, args, wk.sg)
             with np.errstate(under="ignore"):  # distant pairs: exp → 0 is the right answer
-                np.exp(wk["args"][:, :c], out=wk["ex"][:, :c])
-            _pair_accumulate(pi, pj, lo, hi, wk["tx"], wk["ty"], wk["ex"], wk["sg"], out)
+                np.exp(args, out=ex)
+            _pair_accumulate(pi, pj, lo, hi, geo[4], geo[5], ex, wk.sg, out)
+
+
+_SOCIAL = TERMS.index("social")
+_NO_GROUPS = (np.zeros(0, dtype=np.int64), np.zeros(1, dtype=np.int64))
+"""``(order, starts)`` of no groups (the group terms switched off)."""
+
+_COEF = (
+    "desired_factor",
+    "relaxation_time",
+    "goal_threshold",
+    "social_factor",
+    "robot_factor",
+    "robot_scale",
+    "cutoff",
+    "lambda_importance",
+    "gamma",
+    "n",
+    "n_prime",
+    "obstacle_factor",
+    "obstacle_threshold",
+    "obstacle_sigma",
+    "group_repulsion_threshold",
+    "group_coherence_factor",
+    "group_repulsion_factor",
+    "group_gaze_factor",
+    "force_scale",
+)
+"""Order of :meth:`PySocialModel._coefficients` (``robot_scale`` = robot × social factor)."""
+(
+    _C_DESIRED,
+    _C_TAU,
+    _C_GOAL,
+    _C_SOCIAL,
+    _C_ROBOT,
+    _C_ROBOT_SCALE,
+    _C_CUTOFF,
+    _C_LAMBDA,
+    _C_GAMMA,
+    _C_N,
+    _C_N_PRIME,
+    _C_OBSTACLE,
+    _C_OB_THRESHOLD,
+    _C_OB_SIGMA,
+    _C_REP_THRESHOLD,
+    _C_COHERENCE,
+    _C_REPULSION,
+    _C_GAZE,
+    _C_SCALE,
+) = range(len(_COEF))
+
+
+@dataclass(frozen=True, eq=False)
+class _PairWork:
+    """Scratch arrays of the social pipeline for blocks of up to ``k`` pairs."""
+
+    gather: FloatArray
+    """``(4, k)`` gathered position and velocity differences."""
+    geo: FloatArray
+    """``(6, k)`` :func:`_pair_geometry`'s rows (one array: the vectorised kernel needs few base
+    pointers)."""
+    code: IntArray
+    """``(k,)`` half-plane bits."""
+    w: FloatArray
+    """``(k,)`` wrapped angles (rad)."""
+    args: FloatArray
+    """``(4k,)`` exponents, viewed as ``(4, c)`` for a block of ``c`` pairs: contiguous, so
+    that one SIMD ``exp`` loop covers them (per element the same function as row by row)."""
+    ex: FloatArray
+    """``(4k,)`` their exponentials, likewise."""
+    sg: FloatArray
+    """``(2, k)`` signs of θ."""
+
+    @classmethod
+    def allocate(cls, k: int) -> _PairWork:
+        """Uninitialised arrays for ``k`` pairs."""
+        return cls(
+            gather=np.empty((4, k)),
+            geo=np.empty((6, k)),
+            code=np.empty(k, dtype=np.int64),
+            w=np.empty(k),
+            args=np.empty(4 * k),
+            ex=np.empty(4 * k),
+            sg=np.empty((2, k)),
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class _ObstacleIndex:
+    """The obstacle points of a :class:`CellList`, stored in its cell order, cut into blocks.
+
+    Storing the points in scan order (rather than indexing through ``order``) keeps a block's
+    points on a few cache lines; the scan visits them in the same order, so sums are unchanged.
+    """
+
+    xy: FloatArray
+    """``(2, m)`` the points' x and y rows, cell by cell (m)."""
+    cell_blocks: IntArray
+    """``(cells + 1,)`` the blocks of cell ``c`` are ``cell_blocks[c]:cell_blocks[c + 1]``."""
+    block_lo: IntArray
+    """``(b + 1,)`` block ``k`` holds points ``block_lo[k]:block_lo[k + 1]``."""
+    bbox: FloatArray
+    """``(b, 4)`` ``(x_min, x_max, y_min, y_max)`` of each block (m)."""
+    cell_box: FloatArray
+    """``(cells, 4)`` the same of each cell's points (inf, -inf for an empty cell)."""
+    grid: FloatArray
+    """``(3,)`` grid origin x, y and cell size (m)."""
+    shape: IntArray
+    """``(2,)`` cells along x and y."""
+    work: FloatArray
+    """``(4, m)`` scratch for one agent's candidate points."""
+
+    @classmethod
+    def build(cls, cells: CellList) -> _ObstacleIndex:
+        """Index the points of ``cells``."""
+        cell_blocks, block_lo, bbox = _point_blocks(cells.points, cells.order, cells.starts)
+        xy = np.ascontiguousarray(cells.points[cells.order].T)
+        return cls(
+            xy=xy,
+            cell_blocks=cell_blocks,
+            block_lo=block_lo,
+            bbox=bbox,
+            cell_box=_cell_boxes(bbox, cell_blocks),
+            grid=np.array([cells.origin[0], cells.origin[1], cells.cell], dtype=np.float64),
+            shape=np.array(cells.shape, dtype=np.int64),
+            work=np.empty((4, xy.shape[1])),
+        )
 
 
 def desired_force(
@@ -533,7 +619,7 @@ def sample_segments(a: FloatArray, b: FloatArray, resolution: float) -> FloatArr
     owner = np.repeat(np.arange(a.shape[0]), counts)
     k = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
     step = (b - a) / np.maximum(counts - 1, 1)[:, None]
-    pts = a[owner] + k[:, None] * step[owner]
+    pts: FloatArray = a[owner] + k[:, None] * step[owner]
     last = np.cumsum(counts)[counts > 0] - 1
     pts[last] = b[counts > 0]
     return pts
@@ -878,11 +964,11 @@ def _obstacle(
     pos: FloatArray,
     radii: FloatArray,
     active: NDArray[np.bool_],
-    pts: FloatArray,
-    order: IntArray,
+    xy: FloatArray,
     cell_blocks: IntArray,
     block_lo: IntArray,
     bbox: FloatArray,
+    cell_box: FloatArray,
     gx0: float,
     gy0: float,
     cell: float,
@@ -891,17 +977,41 @@ def _obstacle(
     reach: float,
     threshold: float,
     sigma: float,
+    work: FloatArray,
     out: FloatArray,
 ) -> None:
     """PySocialForce's ``ObstacleForce`` (before its factor), scanning the point grid directly.
 
-    ``order`` and the grid geometry are a :class:`CellList`'s, its cells cut into blocks by
-    :func:`_point_blocks`; ``reach`` bounds the search, the exact PySocialForce test
-    ``|r − o| − R < threshold + R`` selects the points. A block whose bounding box is beyond
-    the prefilter is skipped whole: its points would all fail it (rounded differences and
-    squares are monotone), so the sums, in the same order, are the same to the bit.
+    The points are a :class:`CellList`'s in its cell order, cut into blocks by
+    :func:`_point_blocks` (see :class:`_ObstacleIndex`). A cell or block whose bounding box is
+    beyond the prefilter is skipped whole: its points would all fail it (rounded differences
+    and squares are monotone), so the sums, in the same order, are the same to the bit. The
+    blocks left, merged into runs of consecutive points, go to :func:`_obstacle_terms`
+    (vectorised) and :func:`_obstacle_sum` (the exponentials, summed in scan order).
+
+    Args:
+        pos: ``(n, 2)`` positions (m).
+        radii: ``(n,)`` agent radii ``R`` (m).
+        active: ``(n,)`` agents that get the force.
+        xy: ``(2, p)`` the points in cell order (m).
+        cell_blocks: ``(cells + 1,)`` block ranges of the cells.
+        block_lo: ``(b + 1,)`` point ranges of the blocks.
+        bbox: ``(b, 4)`` block bounding boxes (m).
+        cell_box: ``(cells, 4)`` cell bounding boxes (m).
+        gx0: grid origin x (m).
+        gy0: grid origin y (m).
+        cell: grid cell size (m).
+        nx: cells along x.
+        ny: cells along y.
+        reach: search radius (m), a hair over ``threshold + 2·max(radii)``.
+        threshold: PySocialForce's ``threshold`` (m); points count while
+            ``|r − o| − R < threshold + R``.
+        sigma: decay length σ (m).
+        work: ``(4, ≥ p)`` scratch.
+        out: ``(n, 2)`` the sums are added here.
     """
     rings = max(1, math.ceil(reach / cell))
+    runs = np.empty((2, block_lo.shape[0]), dtype=np.int64)
     for i in range(pos.shape[0]):
         if not active[i]:
             continue
@@ -912,31 +1022,299 @@ def _obstacle(
         far2 = (thr + r) * (thr + r) * (1.0 + 1e-9)
         cx = int((x - gx0) // cell)
         cy = int((y - gy0) // cell)
-        fx = 0.0
-        fy = 0.0
+        nruns = 0
         for gy in range(max(cy - rings, 0), min(cy + rings, ny - 1) + 1):
             for gx in range(max(cx - rings, 0), min(cx + rings, nx - 1) + 1):
                 c = gy * nx + gx
+                if _box_gap2(cell_box, c, x, y) >= far2:  # the window's far cells, mostly
+                    continue
                 for blk in range(cell_blocks[c], cell_blocks[c + 1]):
-                    bx = max(bbox[blk, 0] - x, x - bbox[blk, 1], 0.0)
-                    by = max(bbox[blk, 2] - y, y - bbox[blk, 3], 0.0)
-                    if bx * bx + by * by >= far2:
+                    if _box_gap2(bbox, blk, x, y) >= far2:
                         continue
-                    for s in range(block_lo[blk], block_lo[blk + 1]):
-                        j = order[s]
-                        dx = x - pts[j, 0]
-                        dy = y - pts[j, 1]
-                        d2 = dx * dx + dy * dy
-                        if d2 >= far2:
-                            continue
-                        dist = math.sqrt(d2)
-                        gap = dist - r
-                        if gap < thr and dist > 0.0:
-                            w = math.exp(-gap / sigma)
-                            fx += dx / dist * w
-                            fy += dy / dist * w
+                    if nruns > 0 and runs[1, nruns - 1] == block_lo[blk]:
+                        runs[1, nruns - 1] = block_lo[blk + 1]  # extends the last run
+                    else:
+                        runs[0, nruns] = block_lo[blk]
+                        runs[1, nruns] = block_lo[blk + 1]
+                        nruns += 1
+        m = _obstacle_terms(xy, runs, nruns, x, y, r, thr, far2, sigma, work)
+        fx, fy = _obstacle_sum(work, m)
         out[i, 0] += fx
         out[i, 1] += fy
+
+
+@njit(cache=True, error_model="numpy")
+def _obstacle_terms(
+    xy: FloatArray,
+    runs: IntArray,
+    nruns: int,
+    x: float,
+    y: float,
+    r: float,
+    thr: float,
+    far2: float,
+    sigma: float,
+    work: FloatArray,
+) -> int:
+    """Unit vectors, exponents and inclusion of the points in ``runs`` seen from ``(x, y)``.
+
+    Writes, per point of the runs ``xy[:, runs[0, k]:runs[1, k]]`` in order, ``(x − o)/|x − o|``
+    to ``work`` rows 0-1, ``−(|x − o| − r)/σ`` to row 2 and 1.0 to row 3 where the point
+    counts (PySocialForce's ``|x − o| − r < thr``, behind the ``|x − o|² < far2`` prefilter
+    and ``|x − o| > 0``), else 0.0. NumPy's error model: the divisions run unguarded (``x/0``
+    gives inf or NaN, not an exception) so that the loop vectorises (IEEE sqrt and division
+    give the scalar bits); the points they hit are the excluded ones. Returns the count.
+    """
+    k = 0
+    for q in range(nruns):
+        lo = runs[0, q]
+        c = runs[1, q] - lo
+        # Slices indexed from 0: numba then knows the indices are not negative and drops
+        # its wraparound selects, which would keep LLVM from vectorising.
+        px, py = xy[0, lo : lo + c], xy[1, lo : lo + c]
+        ux, uy = work[0, k : k + c], work[1, k : k + c]
+        arg, keep = work[2, k : k + c], work[3, k : k + c]
+        for j in range(c):
+            dx = x - px[j]
+            dy = y - py[j]
+            d2 = dx * dx + dy * dy
+            dist = math.sqrt(d2)
+            gap = dist - r
+            ux[j] = dx / dist
+            uy[j] = dy / dist
+            arg[j] = -gap / sigma
+            keep[j] = (d2 < far2) & (gap < thr) & (dist > 0.0)
+        k += c
+    return k
+
+
+@njit(cache=True)
+def _obstacle_sum(work: FloatArray, m: int) -> tuple[float, float]:
+    """``Σ u · exp(arg)`` over the first ``m`` entries of :func:`_obstacle_terms`, in order."""
+    ux, uy, arg, keep = work[0], work[1], work[2], work[3]
+    fx = 0.0
+    fy = 0.0
+    for k in range(m):
+        if keep[k] != 0.0:  # mostly: only the blocks' corners fall outside
+            w = math.exp(arg[k])
+            fx += ux[k] * w
+            fy += uy[k] * w
+    return fx, fy
+
+
+@njit(cache=True)
+def _terms(
+    pos: FloatArray,
+    vel: FloatArray,
+    dest: FloatArray,
+    vmax: FloatArray,
+    vmax_factor: FloatArray,
+    active: NDArray[np.bool_],
+    rpos: FloatArray,
+    rvel: FloatArray,
+    radii: FloatArray,
+    reach: float,
+    xy: FloatArray,
+    cell_blocks: IntArray,
+    block_lo: IntArray,
+    bbox: FloatArray,
+    cell_box: FloatArray,
+    grid: FloatArray,
+    shape: IntArray,
+    work: FloatArray,
+    order: IntArray,
+    starts: IntArray,
+    coef: FloatArray,
+    wrap: bool,
+    coherence_uses_distance: bool,
+    forces: FloatArray,
+    acc: FloatArray,
+) -> None:
+    """Every term but the social one's pair sums, the factors, and the total, in one call.
+
+    The arithmetic is NumPy's, element by element and in the same order (each term summed
+    unscaled, then multiplied by its factor; inactive agents zeroed, then ``force_scale``,
+    then the terms added to zero in :data:`TERMS` order), so the bits are those of one NumPy
+    call per step of the computation.
+
+    Args:
+        pos: ``(n, 2)`` positions (m).
+        vel: ``(n, 2)`` velocities (m/s).
+        dest: ``(n, 2)`` destinations (m).
+        vmax: ``(n,)`` preferred speeds (m/s).
+        vmax_factor: ``(n,)`` their factors.
+        active: ``(n,)`` agents that get forces.
+        rpos: ``(r, 2)`` robot positions (m).
+        rvel: ``(r, 2)`` robot world-frame velocities (m/s).
+        radii: ``(n,)`` agent radii in the obstacle term (m).
+        reach: obstacle search radius (m), a hair over ``threshold + 2·max(radii)``.
+        xy: :attr:`_ObstacleIndex.xy` (no columns: no obstacles).
+        cell_blocks: :attr:`_ObstacleIndex.cell_blocks`.
+        block_lo: :attr:`_ObstacleIndex.block_lo`.
+        bbox: :attr:`_ObstacleIndex.bbox`.
+        cell_box: :attr:`_ObstacleIndex.cell_box`.
+        grid: :attr:`_ObstacleIndex.grid`.
+        shape: :attr:`_ObstacleIndex.shape`.
+        work: :attr:`_ObstacleIndex.work`.
+        order: :func:`group_members`' order.
+        starts: its starts (length 1: no groups).
+        coef: ``(len(_COEF),)`` the parameters.
+        wrap: wrap the social angle (robots here; pedestrians in the pair pipeline).
+        coherence_uses_distance: pedsim's softened coherence.
+        forces: ``(7, n, 2)`` zeros, plus the unscaled social sums in row ``social``; out: the
+            scaled terms (m/s²).
+        acc: ``(n, 2)`` out: the accelerations (m/s²).
+    """
+    d_, s_, o_, gc_, gr_, gg_, r_ = 0, 1, 2, 3, 4, 5, 6  # rows, in TERMS order
+    _desired(pos, vel, dest, vmax, vmax_factor, coef[_C_TAU], coef[_C_GOAL], forces[d_])
+    _scale(forces[d_], coef[_C_DESIRED])
+    _scale(forces[s_], coef[_C_SOCIAL])
+    if rpos.shape[0] > 0 and coef[_C_ROBOT] > 0.0:
+        _robots(
+            pos,
+            vel,
+            active,
+            rpos,
+            rvel,
+            coef[_C_CUTOFF],
+            coef[_C_LAMBDA],
+            coef[_C_GAMMA],
+            coef[_C_N],
+            coef[_C_N_PRIME],
+            wrap,
+            forces[r_],
+        )
+        _scale(forces[r_], coef[_C_ROBOT_SCALE])
+    if xy.shape[1] > 0:
+        _obstacle(
+            pos,
+            radii,
+            active,
+            xy,
+            cell_blocks,
+            block_lo,
+            bbox,
+            cell_box,
+            grid[0],
+            grid[1],
+            grid[2],
+            shape[0],
+            shape[1],
+            reach,
+            coef[_C_OB_THRESHOLD],
+            coef[_C_OB_SIGMA],
+            work,
+            forces[o_],
+        )
+        _scale(forces[o_], coef[_C_OBSTACLE])
+    if starts.shape[0] > 1:
+        _groups(
+            pos,
+            dest,
+            active,
+            order,
+            starts,
+            coef[_C_REP_THRESHOLD],
+            coherence_uses_distance,
+            forces[gc_],
+            forces[gr_],
+            forces[gg_],
+        )
+        _scale(forces[gc_], coef[_C_COHERENCE])
+        _scale(forces[gr_], coef[_C_REPULSION])
+        _scale(forces[gg_], coef[_C_GAZE])
+    scale = coef[_C_SCALE]
+    for i in range(pos.shape[0]):
+        ax = 0.0
+        ay = 0.0
+        for k in range(forces.shape[0]):
+            if not active[i]:
+                forces[k, i, 0] = 0.0
+                forces[k, i, 1] = 0.0
+            if scale != 1.0:
+                forces[k, i, 0] *= scale
+                forces[k, i, 1] *= scale
+            ax += forces[k, i, 0]
+            ay += forces[k, i, 1]
+        acc[i, 0] = ax
+        acc[i, 1] = ay
+
+
+@njit(cache=True, inline="always")
+def _scale(f: FloatArray, factor: float) -> None:
+    """``f *= factor`` for an ``(n, 2)`` term."""
+    for i in range(f.shape[0]):
+        f[i, 0] *= factor
+        f[i, 1] *= factor
+
+
+@njit(cache=True)
+def _desired(
+    pos: FloatArray,
+    vel: FloatArray,
+    dest: FloatArray,
+    vmax: FloatArray,
+    vmax_factor: FloatArray,
+    relaxation_time: float,
+    goal_threshold: float,
+    out: FloatArray,
+) -> None:
+    """:func:`desired_force` with speed ``vmax · vmax_factor`` into ``out``, the same bits.
+
+    ``hypot`` is libm's in both, and each element sees the same operations in the same order.
+    """
+    for i in range(pos.shape[0]):
+        dx = dest[i, 0] - pos[i, 0]
+        dy = dest[i, 1] - pos[i, 1]
+        dist = math.hypot(dx, dy)
+        if dist > goal_threshold:  # False for NaN, as np.where's test
+            speed = vmax[i] * vmax_factor[i]
+            ux = dx / dist if dist > 0.0 else 0.0
+            uy = dy / dist if dist > 0.0 else 0.0
+            out[i, 0] = (ux * speed - vel[i, 0]) / relaxation_time
+            out[i, 1] = (uy * speed - vel[i, 1]) / relaxation_time
+        else:
+            out[i, 0] = -vel[i, 0] / relaxation_time
+            out[i, 1] = -vel[i, 1] / relaxation_time
+
+
+@njit(cache=True)
+def _same_ints(a: IntArray, b: IntArray) -> bool:
+    """``np.array_equal`` for two 1-d integer arrays, without NumPy's call overhead."""
+    if a.shape[0] != b.shape[0]:
+        return False
+    for i in range(a.shape[0]):  # noqa: SIM110 (numba: a loop, not all() of a generator)
+        if a[i] != b[i]:
+            return False
+    return True
+
+
+@njit(cache=True, inline="always")
+def _box_gap2(box: FloatArray, k: int, x: float, y: float) -> float:
+    """Squared distance (m²) from ``(x, y)`` to box ``k`` of ``box`` ``(·, 4)``, 0 inside.
+
+    A lower bound of every contained point's ``dx² + dy²`` as rounded (rounding is monotone),
+    so ``≥ far2`` rules out the whole box without changing any sum.
+    """
+    bx: float = max(box[k, 0] - x, x - box[k, 1], 0.0)
+    by: float = max(box[k, 2] - y, y - box[k, 3], 0.0)
+    return bx * bx + by * by
+
+
+@njit(cache=True)
+def _cell_boxes(bbox: FloatArray, cell_blocks: IntArray) -> FloatArray:
+    """``(cells, 4)`` bounding boxes of each cell's blocks ``bbox`` ``(b, 4)`` (m)."""
+    cells = cell_blocks.shape[0] - 1
+    out = np.empty((cells, 4))
+    for c in range(cells):
+        out[c, 0] = out[c, 2] = math.inf
+        out[c, 1] = out[c, 3] = -math.inf
+        for blk in range(cell_blocks[c], cell_blocks[c + 1]):
+            out[c, 0] = min(out[c, 0], bbox[blk, 0])
+            out[c, 1] = max(out[c, 1], bbox[blk, 1])
+            out[c, 2] = min(out[c, 2], bbox[blk, 2])
+            out[c, 3] = max(out[c, 3], bbox[blk, 3])
+    return out
 
 
 @njit(cache=True)
