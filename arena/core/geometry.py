@@ -6,6 +6,7 @@ Polygons are ``(k, 2)`` vertex arrays in order (either orientation), implicitly 
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
@@ -78,13 +79,36 @@ def bounding_radius(polygon: ArrayLike) -> float:
 
 def points_in_polygon(points: ArrayLike, polygon: ArrayLike) -> NDArray[np.bool_]:
     """Even-odd rule test for ``(n, 2)`` points against one polygon → ``(n,)`` bool."""
-    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    a, b = polygon_edges(polygon)
-    px, py = p[:, 0:1], p[:, 1:2]
-    crosses = (a[:, 1] > py) != (b[:, 1] > py)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x_at = a[:, 0] + (py - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
-    inside: NDArray[np.bool_] = np.count_nonzero(crosses & (px < x_at), axis=1) % 2 == 1
+    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    poly = np.ascontiguousarray(np.asarray(polygon, dtype=np.float64))
+    inside: NDArray[np.bool_] = _points_in_polygon(p, poly.reshape(-1, 2))
+    return inside
+
+
+@njit(cache=True)
+def _points_in_polygon(p: FloatArray, poly: FloatArray) -> NDArray[np.bool_]:
+    """Count the edges ``a→b`` that a ray from each point towards +x crosses.
+
+    An edge counts when it straddles the point's ``y`` and its ``x`` there,
+    ``a_x + (y - a_y)(b_x - a_x) / (b_y - a_y)``, lies right of the point: the float
+    operations of the vectorised version this replaced (so the same answers), without its
+    ``(n, k)`` temporaries (rasterising one footprint made a dozen of them).
+    """
+    n = p.shape[0]
+    k = poly.shape[0]
+    inside = np.zeros(n, dtype=np.bool_)
+    for i in range(n):
+        px = p[i, 0]
+        py = p[i, 1]
+        count = 0
+        for e in range(k):
+            ax = poly[e, 0]
+            ay = poly[e, 1]
+            bx = poly[(e + 1) % k, 0]
+            by = poly[(e + 1) % k, 1]
+            if (ay > py) != (by > py) and px < ax + (py - ay) * (bx - ax) / (by - ay):
+                count += 1
+        inside[i] = count % 2 == 1
     return inside
 
 
@@ -189,14 +213,57 @@ def convex_polygon_overlaps_squares(
     """
     poly = np.asarray(polygon, dtype=np.float64)
     c = np.asarray(centers, dtype=np.float64).reshape(-1, 2)
-    ok = (c[:, 0] - half_size < poly[:, 0].max()) & (c[:, 0] + half_size > poly[:, 0].min())
-    ok &= (c[:, 1] - half_size < poly[:, 1].max()) & (c[:, 1] + half_size > poly[:, 1].min())
     edges = np.roll(poly, -1, axis=0) - poly
     normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1)  # (k, 2)
+    # The projections stay numpy matrix products: BLAS may fuse their multiply-adds, and the
+    # answers must not change; the comparisons run in one pass without (m, k) temporaries.
     proj_poly = poly @ normals.T  # (k_vertices, k_axes)
-    pmin, pmax = proj_poly.min(axis=0), proj_poly.max(axis=0)
     proj_c = c @ normals.T  # (m, k_axes)
-    extent = half_size * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
-    ok &= np.all((proj_c - extent < pmax) & (proj_c + extent > pmin), axis=1)
-    result: NDArray[np.bool_] = ok
+    xmax, xmin = poly[:, 0].max(), poly[:, 0].min()
+    box = (xmin, xmax, poly[:, 1].min(), poly[:, 1].max())
+    result: NDArray[np.bool_] = _squares_overlap(
+        c, float(half_size), box, normals, proj_poly.min(axis=0), proj_poly.max(axis=0), proj_c
+    )
     return result
+
+
+@njit(cache=True)
+def _squares_overlap(
+    c: FloatArray,
+    half_size: float,
+    box: tuple[float, float, float, float],
+    normals: FloatArray,
+    pmin: FloatArray,
+    pmax: FloatArray,
+    proj_c: FloatArray,
+) -> NDArray[np.bool_]:
+    """The tests of :func:`convex_polygon_overlaps_squares` on given projections.
+
+    Each square must overlap the polygon's bounding box ``(xmin, xmax, ymin, ymax)``, then on
+    every edge normal ``a`` its projection ``proj_c ± half_size · (|n_x| + |n_y|)`` must
+    overlap the polygon's ``[pmin, pmax]``.
+    """
+    xmin, xmax, ymin, ymax = box
+    k = normals.shape[0]
+    m = c.shape[0]
+    ok = np.zeros(m, dtype=np.bool_)
+    extent = np.empty(k)
+    for a in range(k):
+        extent[a] = half_size * (abs(normals[a, 0]) + abs(normals[a, 1]))
+    for i in range(m):
+        cx = c[i, 0]
+        cy = c[i, 1]
+        if not (
+            cx - half_size < xmax
+            and cx + half_size > xmin
+            and cy - half_size < ymax
+            and cy + half_size > ymin
+        ):
+            continue
+        hit = True
+        for a in range(k):
+            if not (proj_c[i, a] - extent[a] < pmax[a] and proj_c[i, a] + extent[a] > pmin[a]):
+                hit = False
+                break
+        ok[i] = hit
+    return ok

@@ -21,14 +21,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from numpy.typing import NDArray
 
 from arena.core.errors import SamplingError
-from arena.core.geometry import point_segment_distance, points_in_polygon
+from arena.core.geometry import points_in_polygon
 from arena.maps.grid import OccupancyGrid
-from arena.maps.raster import disk_mask, polygon_mask
+from arena.maps.raster import disk_mask, or_disk, polygon_mask, polygon_window
 from arena.sim.state import Obstacle
-from arena.tasks.sampling import squared_edt
+from arena.tasks.sampling import MaskRegions, grid_memo, squared_edt
 
 FloatArray = NDArray[np.float64]
 
@@ -44,10 +45,101 @@ class ForbiddenDisc:
 
 def polygon_distance(points: FloatArray, polygon: FloatArray) -> FloatArray:
     """Distance (m) from ``(n, 2)`` points to a filled polygon ``(k, 2)``; 0 inside."""
-    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    poly = np.asarray(polygon, dtype=np.float64)
-    d = point_segment_distance(p, poly, np.roll(poly, -1, axis=0)).min(axis=1)
-    return np.where(points_in_polygon(p, poly), 0.0, d)
+    return polygons_distance(points, [polygon])
+
+
+def polygons_distance(points: FloatArray, polygons: Sequence[FloatArray]) -> FloatArray:
+    """Distance (m) from ``(n, 2)`` points to the nearest of some filled polygons; ``inf`` if none.
+
+    The minimum over ``polygons`` (each ``(k, 2)``, ``k ≥ 1``) of :func:`polygon_distance`.
+    """
+    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    polys = [np.asarray(q, dtype=np.float64) for q in polygons]
+    if not polys:
+        return np.full(len(p), np.inf)
+    if any(len(q) == 0 for q in polys):  # the vectorised form's error for an empty polygon
+        raise ValueError("zero-size array to reduction operation minimum which has no identity")
+    offsets = np.cumsum([0] + [len(q) for q in polys])
+    verts = np.ascontiguousarray(np.concatenate(polys).reshape(-1, 2))
+    distance: FloatArray = _polygons_distance(p, verts, offsets)
+    return distance
+
+
+@njit(cache=True, error_model="numpy")
+def _polygons_distance(
+    p: FloatArray, verts: FloatArray, offsets: NDArray[np.int64]
+) -> FloatArray:
+    """Polygon ``g`` has vertices ``verts[offsets[g]:offsets[g + 1]]``.
+
+    Per polygon: 0 if the point is inside (even-odd rule), else the distance to the nearest
+    edge; then the minimum over polygons. The float operations are those of
+    :func:`~arena.core.geometry.points_in_polygon` and
+    :func:`~arena.core.geometry.point_segment_distance` (``t`` clipped to [0, 1], NaN → 0;
+    ``sqrt(dx² + dy²)``), and NaN propagates through the minima as through ``np.minimum``:
+    the same distances, without a dozen numpy temporaries per polygon and batch.
+    """
+    n = p.shape[0]
+    out = np.full(n, np.inf)
+    for g in range(offsets.shape[0] - 1):
+        s = offsets[g]
+        k = offsets[g + 1] - s
+        for i in range(n):
+            px = p[i, 0]
+            py = p[i, 1]
+            crossings = 0
+            best = np.inf
+            for e in range(k):
+                ax = verts[s + e, 0]
+                ay = verts[s + e, 1]
+                bx = verts[s + (e + 1) % k, 0]
+                by = verts[s + (e + 1) % k, 1]
+                if (ay > py) != (by > py) and px < ax + (py - ay) * (bx - ax) / (by - ay):
+                    crossings += 1
+                abx = bx - ax
+                aby = by - ay
+                t = ((px - ax) * abx + (py - ay) * aby) / (abx * abx + aby * aby)
+                if t != t:
+                    t = 0.0
+                t = min(max(t, 0.0), 1.0)
+                dx = px - (ax + t * abx)
+                dy = py - (ay + t * aby)
+                best = _minimum(best, np.sqrt(dx * dx + dy * dy))
+            out[i] = _minimum(out[i], 0.0 if crossings % 2 == 1 else best)
+    return out
+
+
+@njit(cache=True)
+def _minimum(a: float, b: float) -> float:
+    """``np.minimum`` of two floats: NaN if either is NaN."""
+    if a != a or b != b:
+        return np.nan
+    return a if a <= b else b
+
+
+@njit(cache=True)
+def _accept(candidates: FloatArray, chosen: FloatArray, count: int, min_gap: float) -> int:
+    """Append to ``chosen[:count]`` each candidate ≥ ``min_gap`` from all chosen so far.
+
+    ``chosen`` ``(n, 2)`` fills up to ``n`` rows; returns the new count. The test is the one
+    it replaced, ``np.hypot(*(p - q)) >= min_gap`` per pair (the same ``hypot``), in a loop
+    that was a reset's largest Python cost.
+    """
+    n = chosen.shape[0]
+    for m in range(candidates.shape[0]):
+        if count == n:
+            break
+        px = candidates[m, 0]
+        py = candidates[m, 1]
+        free = True
+        for j in range(count):
+            if not np.hypot(px - chosen[j, 0], py - chosen[j, 1]) >= min_gap:
+                free = False
+                break
+        if free:
+            chosen[count, 0] = px
+            chosen[count, 1] = py
+            count += 1
+    return count
 
 
 def wall_distance_map(grid: OccupancyGrid) -> FloatArray:
@@ -89,22 +181,30 @@ class WorldSampler:
         """Add obstacle footprints to the obstacle layer."""
         polys = [np.asarray(o.polygon, dtype=np.float64) for o in obstacles]
         self._polygons.extend(polys)
-        if self._blocked_cache is not None and polys:  # update in place: O(new shapes)
-            self._blocked_cache |= polygon_mask(self.grid, polys)
+        if self._blocked_cache is not None:  # update in place: O(new shapes)
+            for poly in polys:
+                self._or_polygon(self._blocked_cache, poly)
 
     def forbid(self, xy: Sequence[float] | FloatArray, radius: float) -> None:
         """Add a forbidden disc (Arena adds every robot start and goal this way)."""
         zone = ForbiddenDisc(float(xy[0]), float(xy[1]), float(radius))
         self._forbidden_discs.append(zone)
         if self._blocked_cache is not None:
-            _or_disk(self._blocked_cache, self.grid, zone.x, zone.y, zone.radius)
+            or_disk(self._blocked_cache, self.grid, zone.x, zone.y, zone.radius)
 
     def forbid_polygon(self, polygon: FloatArray) -> None:
         """Add a forbidden polygon (m)."""
         poly = np.asarray(polygon, dtype=np.float64)
         self._forbidden_polygons.append(poly)
         if self._blocked_cache is not None:
-            self._blocked_cache |= polygon_mask(self.grid, [poly])
+            self._or_polygon(self._blocked_cache, poly)
+
+    def _or_polygon(self, mask: NDArray[np.bool_], poly: FloatArray) -> None:
+        """``mask |= polygon_mask(grid, [poly])`` on the polygon's bounding box only."""
+        window = polygon_window(self.grid, poly)
+        if window is not None:
+            r0, c0, win = window
+            mask[r0 : r0 + win.shape[0], c0 : c0 + win.shape[1]] |= win
 
     def clear_forbidden(self) -> None:
         """Empty the forbidden layer (module ``clear_forbidden_zones``)."""
@@ -162,11 +262,7 @@ class WorldSampler:
 
     def obstacle_distance(self, points: FloatArray) -> FloatArray:
         """Distance (m) from points to the nearest obstacle footprint (``inf`` if none)."""
-        p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-        d = np.full(len(p), np.inf)
-        for poly in self._polygons:
-            d = np.minimum(d, polygon_distance(p, poly))
-        return d
+        return polygons_distance(points, self._polygons)
 
     def forbidden_distance(self, points: FloatArray) -> FloatArray:
         """Distance (m) from points to the nearest forbidden zone (``inf`` if none)."""
@@ -176,8 +272,8 @@ class WorldSampler:
             discs = np.array([[z.x, z.y, z.radius] for z in self._forbidden_discs])
             dd = np.hypot(p[:, None, 0] - discs[None, :, 0], p[:, None, 1] - discs[None, :, 1])
             d = np.minimum(d, np.maximum(dd - discs[None, :, 2], 0.0).min(axis=1))
-        for poly in self._forbidden_polygons:
-            d = np.minimum(d, polygon_distance(p, poly))
+        if self._forbidden_polygons:
+            d = np.minimum(d, polygons_distance(p, self._forbidden_polygons))
         return d
 
     def clearance(self, points: FloatArray) -> FloatArray:
@@ -199,6 +295,23 @@ class WorldSampler:
         # within res/√2 of that centre: centre distance ≥ clearance + res·√2 is sufficient.
         ok = (self._wall >= clearance + res * math.sqrt(2.0)) & self.grid.free
         return ok & ~self._blocked()
+
+    def _candidate_at(self, flat: NDArray[np.intp], clearance: float) -> NDArray[np.bool_]:
+        """:meth:`candidate_mask` at the given flat cell indices (the same tests, elementwise)."""
+        res = self.grid.resolution
+        ok = self._wall.ravel()[flat] >= clearance + res * math.sqrt(2.0)
+        return ok & self.grid.free.ravel()[flat] & ~self._blocked().ravel()[flat]
+
+    def candidate_regions(self, clearance: float) -> MaskRegions:
+        """The 8-connected regions of :meth:`candidate_mask` (what ``components`` labels).
+
+        Memoised per map by the mask's content: a reset's first request (a robot's start and
+        goal, before anything is placed) finds the same mask every episode on a fixed map.
+        """
+        mask = self.candidate_mask(clearance)
+        mask.setflags(write=False)
+        key = ("candidate regions", mask.shape, np.packbits(mask).tobytes())
+        return grid_memo(self.grid, key, lambda: MaskRegions(mask))
 
     def _blocked(self) -> NDArray[np.bool_]:
         """Cells covered by an obstacle or a forbidden zone (a cheap pre-filter)."""
@@ -225,6 +338,7 @@ class WorldSampler:
         *,
         what: str,
         within: NDArray[np.bool_] | None = None,
+        cells: NDArray[np.intp] | None = None,
         polygon: FloatArray | None = None,
         forbid: bool = True,
         max_tries: int = 2000,
@@ -238,6 +352,10 @@ class WorldSampler:
             what: names the request in errors ("3 pedestrians").
             within: optional ``(H, W)`` mask the positions must fall in (e.g. one connected
                 region).
+            cells: optional ascending, distinct flat indices (into the ``(H, W)`` grid) of the
+                cells the positions must fall in: ``within`` given as
+                ``np.flatnonzero(within)``, with the same result, for callers that have a
+                region's cells and not its mask.
             polygon: optional polygon (m) the positions must lie inside (zones).
             forbid: make each accepted position a forbidden disc of radius ``clearance`` (so
                 later positions keep away from it); positions of one call are always kept
@@ -251,11 +369,19 @@ class WorldSampler:
             return np.zeros((0, 2))
         shape = self.grid.data.shape
         flat: NDArray[np.intp] | None = None
-        if within is None and polygon is None:
+        if within is None and cells is None and polygon is None:
             # Fast path: draw from all free cells and filter each batch; the full candidate
             # mask (a pass over the whole grid) is only built if that fails.
             pool = self._free_flat()
             wall_min = clearance + self.grid.resolution * math.sqrt(2.0)
+        elif cells is not None:
+            # The candidate test on the given cells only (no full-map mask).
+            ok = self._candidate_at(np.asarray(cells, dtype=np.intp), clearance)
+            if within is not None:
+                ok &= within.ravel()[cells]
+            if polygon is not None:
+                ok &= self._polygon_cells(polygon).ravel()[cells]
+            pool = flat = np.asarray(cells, dtype=np.intp)[ok]
         else:
             mask = self.candidate_mask(clearance)
             if within is not None:
@@ -263,9 +389,10 @@ class WorldSampler:
             if polygon is not None:
                 mask = mask & self._polygon_cells(polygon)
             pool = flat = np.flatnonzero(mask)
-        chosen: list[FloatArray] = []
+        chosen = np.empty((n, 2))  # rows [:count] accepted so far
+        count = 0
         tries = 0
-        while len(chosen) < n and pool.size and tries < max_tries:
+        while count < n and pool.size and tries < max_tries:
             batch = min(256, max_tries - tries)
             tries += batch
             idx = rng.choice(pool, size=batch)
@@ -273,28 +400,39 @@ class WorldSampler:
                 idx = idx[(self._wall.flat[idx] >= wall_min) & ~self._blocked().flat[idx]]
             pts = self._jitter(np.stack(np.unravel_index(idx, shape), axis=1), rng)
             ok = self._admissible(pts, clearance, polygon)
-            for p in pts[ok]:
-                if all(np.hypot(*(p - q)) >= 2 * clearance for q in chosen):
-                    chosen.append(p)
-                    if len(chosen) == n:
-                        break
-        if len(chosen) < n:
+            count = _accept(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
+        if count < n:
             if flat is None:
                 flat = np.flatnonzero(self.candidate_mask(clearance))
-            chosen = self._exhaustive(flat, shape, n, chosen, clearance, polygon, rng, what)
-        out = np.array(chosen[:n], dtype=np.float64).reshape(n, 2)
+            found = self._exhaustive(
+                flat, shape, n, list(chosen[:count]), clearance, polygon, rng, what
+            )
+            chosen = np.array(found[:n], dtype=np.float64).reshape(n, 2)
         if forbid:
-            for p in out:
+            for p in chosen:
                 self.forbid(p, clearance)
-        return out
+        return chosen
 
     def _free_flat(self) -> NDArray[np.intp]:
         if self._free_cache is None:
-            self._free_cache = np.flatnonzero(self.grid.free)
+            self._free_cache = grid_memo(self.grid, "free cells", self._free_cells)
         return self._free_cache
 
+    def _free_cells(self) -> NDArray[np.intp]:
+        flat = np.flatnonzero(self.grid.free)
+        flat.setflags(write=False)
+        return flat
+
     def _exhaustive(
-        self, flat, shape, n, chosen, clearance, polygon, rng, what: str
+        self,
+        flat: NDArray[np.intp],
+        shape: tuple[int, ...],
+        n: int,
+        chosen: list[FloatArray],
+        clearance: float,
+        polygon: FloatArray | None,
+        rng: np.random.Generator,
+        what: str,
     ) -> list[FloatArray]:
         """Last attempt: every candidate cell centre in random order (fails only if none fit)."""
         if flat.size:
@@ -313,7 +451,9 @@ class WorldSampler:
             f"({flat.size} candidate cells); reduce counts or clearances, or use a larger map"
         )
 
-    def _admissible(self, pts: FloatArray, clearance: float, polygon: FloatArray | None):
+    def _admissible(
+        self, pts: FloatArray, clearance: float, polygon: FloatArray | None
+    ) -> NDArray[np.bool_]:
         ok = self.obstacle_distance(pts) >= clearance
         ok &= self.forbidden_distance(pts) >= clearance
         if polygon is not None:
@@ -339,22 +479,3 @@ class WorldSampler:
         inside = points_in_polygon(g.cell_to_world(cells), poly)
         mask[cells[inside, 0], cells[inside, 1]] = True
         return mask
-
-
-def _or_disk(mask: NDArray[np.bool_], grid: OccupancyGrid, x: float, y: float, r: float) -> None:
-    """``mask |= disk_mask(grid, [[x, y]], [r])``, touching only the disc's window.
-
-    The same window and cell test as :func:`~arena.maps.raster.disk_mask`; a reset forbids a
-    few dozen discs, and a full-map mask per disc cost most of their time.
-    """
-    res = grid.resolution
-    k = math.ceil(r / res) + 1
-    row, col = grid.world_to_cell([x, y])
-    r0, r1 = max(row - k, 0), min(row + k + 1, grid.height)
-    c0, c1 = max(col - k, 0), min(col + k + 1, grid.width)
-    if r0 >= r1 or c0 >= c1:
-        return
-    rows, cols = np.mgrid[r0:r1, c0:c1]
-    cx = grid.origin[0] + (cols + 0.5) * res
-    cy = grid.origin[1] + (rows + 0.5) * res
-    mask[r0:r1, c0:c1] |= (cx - x) ** 2 + (cy - y) ** 2 <= r * r

@@ -102,3 +102,62 @@ def test_convex_polygon_overlaps_squares_matches_sampling():
             # A miss by sampling but a hit by SAT is only allowed within the sampling gap.
             if flag and not sampled:
                 assert np.min(g.point_segment_distance(c[None], poly, np.roll(poly, -1, 0))) < 0.15
+
+
+def _reference_points_in_polygon(points, polygon):
+    """The vectorised even-odd test the kernel replaced."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    a = np.asarray(polygon, dtype=np.float64)
+    b = np.roll(a, -1, axis=0)
+    px, py = p[:, 0:1], p[:, 1:2]
+    crosses = (a[:, 1] > py) != (b[:, 1] > py)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x_at = a[:, 0] + (py - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    return np.count_nonzero(crosses & (px < x_at), axis=1) % 2 == 1
+
+
+def _reference_squares(polygon, centers, half_size):
+    """The vectorised separating-axis test the kernel replaced."""
+    poly = np.asarray(polygon, dtype=np.float64)
+    c = np.asarray(centers, dtype=np.float64).reshape(-1, 2)
+    ok = (c[:, 0] - half_size < poly[:, 0].max()) & (c[:, 0] + half_size > poly[:, 0].min())
+    ok &= (c[:, 1] - half_size < poly[:, 1].max()) & (c[:, 1] + half_size > poly[:, 1].min())
+    edges = np.roll(poly, -1, axis=0) - poly
+    normals = np.stack([-edges[:, 1], edges[:, 0]], axis=1)
+    proj_poly = poly @ normals.T
+    pmin, pmax = proj_poly.min(axis=0), proj_poly.max(axis=0)
+    proj_c = c @ normals.T
+    extent = half_size * (np.abs(normals[:, 0]) + np.abs(normals[:, 1]))
+    return ok & np.all((proj_c - extent < pmax) & (proj_c + extent > pmin), axis=1)
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_points_in_polygon_matches_vectorised_reference(seed):
+    rng = np.random.default_rng(seed)
+    poly = rng.normal(size=(int(rng.integers(0, 10)), 2)) * rng.uniform(0.1, 4)
+    pts = rng.normal(size=(int(rng.integers(0, 300)), 2)) * 3
+    if seed % 2:  # grid-aligned: points on vertices and edges, horizontal edges
+        poly, pts = np.round(poly * 4) / 4, np.round(pts * 8) / 8
+        k = min(len(poly), len(pts))
+        pts[:k] = poly[:k]
+    got = g.points_in_polygon(pts, poly)
+    want = _reference_points_in_polygon(pts, poly)
+    assert got.dtype == want.dtype and np.array_equal(got, want)
+    assert g.points_in_polygon([0.2, 0.1], [[0, 0], [1, 0], [1, 1]]).tolist() == [True]
+
+
+@pytest.mark.parametrize("seed", range(30))
+def test_convex_polygon_overlaps_squares_matches_vectorised_reference(seed):
+    rng = np.random.default_rng(seed)
+    if seed % 3 == 0:
+        size = np.round(rng.uniform(0.2, 2, 2) * 20) / 20
+        poly = g.rectangle(*size, center=(0.05 * int(rng.integers(-9, 9)), 0.025))
+    elif seed % 3 == 1:
+        poly = g.transform_points(g.rectangle(*rng.uniform(0.1, 2, 2)), rng.normal(size=3))
+    else:
+        poly = g.convex_hull(rng.normal(size=(8, 2)))
+    centers = (rng.integers(-50, 50, size=(int(rng.integers(0, 600)), 2)) + 0.5) * 0.05
+    for half in (0.025, 0.1):
+        got = g.convex_polygon_overlaps_squares(poly, centers, half)
+        want = _reference_squares(poly, centers, half)
+        assert got.dtype == want.dtype and np.array_equal(got, want)

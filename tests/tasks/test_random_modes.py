@@ -144,29 +144,60 @@ def test_never_samples_in_unknown_space(tmp_path):
         assert np.all(grid.data[cells[:, 0], cells[:, 1]] == 0)
 
 
-def test_batched_visibility_matches_line_of_sight():
-    """The waypoint kernel picks the first candidate that ``line_of_sight`` accepts."""
-    from arena.tasks.obstacle_modes.random import _first_visible
+@pytest.mark.parametrize("near_ok", [False, True])
+def test_waypoint_kernel_matches_numpy_batch(near_ok):
+    """The waypoint kernel picks what jitter + hypot + ``line_of_sight`` picked, bit for bit."""
+    from arena.tasks.obstacle_modes.random import _pick_waypoint
+    from arena.tasks.sampling import jitter
 
     ep = generator(obstacles={"type": "random", "static": 3, "dynamic": 2}).episode(0)
     grid = ep.grid
     walkable = grid.free & ~grid.occupied
+    region = np.argwhere(walkable)
     rng = np.random.default_rng(1)
-    lo = np.array(grid.origin) - 1.0
-    size = np.array([grid.width, grid.height]) * grid.resolution
-    hi = np.array(grid.origin) + size + 1.0
+    lo, hi = (2.0, 8.0)
+    d_min, d_max = (0.5, np.inf) if near_ok else (lo, hi)
     hits = 0
     for _ in range(200):
-        a = rng.uniform(lo, hi)
-        pts = rng.uniform(lo, hi, size=(16, 2))
-        ok = rng.random(16) < 0.7
-        m = _first_visible(
-            pts, ok, float(a[0]), float(a[1]), float(grid.origin[0]), float(grid.origin[1]),
-            float(grid.resolution), grid.height, grid.width, walkable,
+        a = grid.cell_to_world(region[rng.integers(len(region))]) + rng.uniform(-0.02, 0.02, 2)
+        pick = rng.integers(len(region), size=16)
+        state = rng.bit_generator.state
+        pts = jitter(grid, region[pick], rng)
+        rng.bit_generator.state = state
+        u = rng.uniform(-0.5, 0.5, size=(16, 2))
+        out = np.empty(2)
+        found = _pick_waypoint(
+            region, pick, u, float(a[0]), float(a[1]), d_min, d_max, near_ok,
+            float(grid.origin[0]), float(grid.origin[1]), float(grid.resolution),
+            grid.height, grid.width, walkable, out,
         )
+        d = np.hypot(*(pts - a).T)
+        ok = (d >= d_min) if near_ok else (d >= lo) & (d <= hi)
         want = next(
             (i for i in range(16) if ok[i] and line_of_sight(grid, walkable, a, pts[i])), -1
         )
-        assert m == want
-        hits += m >= 0
+        assert found == (want >= 0)
+        if found:
+            assert out.tobytes() == pts[want].tobytes()
+        hits += found
     assert hits > 10
+
+
+@pytest.mark.parametrize("far", [12.05, 5.05, 0.15, 0.05, 0.0])
+def test_far_cells_match_the_full_map_test(far):
+    """Goal cells: the kernel's shortcut keeps exactly the cells ``np.hypot`` keeps."""
+    from arena.tasks.robot_modes.random import _far_cells
+
+    grid = OccupancyGrid.empty(24.0, 16.0, 0.05, origin=(-12.0, -8.0))
+    rows, cols = np.indices(grid.data.shape)
+    cells = np.stack([rows.ravel(), cols.ravel()], axis=1).astype(np.int64)
+    cx = grid.origin[0] + (cols + 0.5) * grid.resolution
+    cy = grid.origin[1] + (rows + 0.5) * grid.resolution
+    rng = np.random.default_rng(int(far * 100))
+    starts = [grid.cell_to_world([100, 200]), *rng.uniform([-12, -8], [12, 8], size=(3, 2))]
+    for x, y in starts:  # a cell centre first: exact ties on the circle
+        want = np.flatnonzero(np.hypot(cx - x, cy - y) >= far)
+        got = _far_cells(
+            cells, grid.origin[0], grid.origin[1], grid.resolution, grid.width, x, y, far
+        )
+        assert np.array_equal(got, want)

@@ -6,7 +6,8 @@ from arena.core.geometry import point_segment_distance, points_in_polygon
 from arena.maps.generators import MAP_GENERATORS
 from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle
-from arena.tasks.world import WorldSampler, polygon_distance
+from arena.tasks.sampling import components
+from arena.tasks.world import WorldSampler, polygon_distance, polygons_distance
 
 
 def brute_wall_distance(grid: OccupancyGrid, pts: np.ndarray) -> np.ndarray:
@@ -94,3 +95,63 @@ def test_clear_forbidden():
         world.sample(1, 0.3, np.random.default_rng(0), what="x")
     world.clear_forbidden()
     assert world.sample(1, 0.3, np.random.default_rng(0), what="x").shape == (1, 2)
+
+
+def _reference_polygon_distance(points, polygon):
+    """The vectorised form the kernel replaced."""
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
+    poly = np.asarray(polygon, dtype=np.float64)
+    d = point_segment_distance(p, poly, np.roll(poly, -1, axis=0)).min(axis=1)
+    return np.where(points_in_polygon(p, poly), 0.0, d)
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_polygons_distance_is_the_minimum_of_the_reference(seed):
+    rng = np.random.default_rng(seed)
+    polys = [
+        rng.normal(size=(int(rng.integers(1, 9)), 2)) * rng.uniform(0.2, 3) + rng.normal(size=2)
+        for _ in range(int(rng.integers(1, 5)))
+    ]
+    pts = rng.normal(size=(200, 2)) * 4
+    if seed % 2:  # grid-aligned values: ties, horizontal edges, points on vertices
+        polys = [np.round(q * 4) / 4 for q in polys]
+        pts = np.round(pts * 8) / 8
+        pts[:3] = polys[0][:3] if len(polys[0]) >= 3 else pts[:3]
+    pts[5] = np.nan
+    want = np.full(len(pts), np.inf)
+    for q in polys:
+        want = np.minimum(want, _reference_polygon_distance(pts, q))
+    assert np.array_equal(polygons_distance(pts, polys), want, equal_nan=True)
+    assert np.array_equal(
+        polygon_distance(pts, polys[0]), _reference_polygon_distance(pts, polys[0]), equal_nan=True
+    )
+    assert np.all(np.isinf(polygons_distance(pts, [])))
+
+
+def test_sample_cells_equals_within():
+    grid = MAP_GENERATORS.build({"type": "rosnav_indoor"}).build(np.random.default_rng(2)).grid
+    within = np.zeros(grid.data.shape, dtype=bool)
+    within[: grid.height // 2, : grid.width // 3] = True
+    for seed in range(5):
+        world_a, world_b = WorldSampler(grid), WorldSampler(grid)
+        a = world_a.sample(3, 0.3, np.random.default_rng(seed), what="a", within=within)
+        b = world_b.sample(
+            3, 0.3, np.random.default_rng(seed), what="b", cells=np.flatnonzero(within)
+        )
+        assert a.tobytes() == b.tobytes()
+        assert world_a.forbidden_discs == world_b.forbidden_discs
+
+
+def test_candidate_regions_are_reused_and_follow_the_mask():
+    grid = MAP_GENERATORS.build({"type": "rosnav_indoor"}).build(np.random.default_rng(2)).grid
+    first = WorldSampler(grid).candidate_regions(0.4)
+    again = WorldSampler(grid).candidate_regions(0.4)
+    assert again is first  # the same map and mask: one labelling for every reset
+    world = WorldSampler(grid)
+    labels = components(world.candidate_mask(0.4))
+    r, c = np.argwhere(labels > 0)[0]
+    world.forbid(grid.cell_to_world([r, c]), 1.0)  # changes the mask: no stale regions
+    changed = world.candidate_regions(0.4)
+    assert changed is not first
+    assert not changed.cells(r, c).size
+    assert np.array_equal(first.cells(r, c), np.argwhere(labels == labels[r, c]))

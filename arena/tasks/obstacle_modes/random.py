@@ -24,11 +24,17 @@ from arena.core.errors import SamplingError
 from arena.core.geometry import rectangle
 from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle, obstacle_models
-from arena.maps.raster import polygon_mask
+from arena.maps.raster import polygon_mask, polygon_window
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn
-from arena.tasks.sampling import clearance_map, components, jitter
+from arena.tasks.sampling import (
+    MaskRegions,
+    clear_near,
+    clearance_map,
+    grid_memo,
+    max_blocked_sq,
+)
 
 BOX = "box"
 """Pseudo-model: a cuboid with random edge lengths."""
@@ -232,32 +238,19 @@ def place_pedestrians(
     for r in ctx.spawns:
         world.forbid(r.start.xy, r.model.radius + p.agent_robot_clearance)
     starts = world.sample(n, body, rng, what=f"{n} pedestrians")
-    obstacles = list(ctx.map.obstacles) + list(placed)
-    blocked = grid.occupied | ~grid.free
-    if obstacles:
-        blocked = blocked | polygon_mask(grid, [o.polygon for o in obstacles])
-    walkable = (clearance_map(grid, blocked) > body) & grid.free
-    labels = components(walkable)
-    cells = np.argwhere(walkable)
-    cell_labels = labels[cells[:, 0], cells[:, 1]]
+    walkable = walkable_mask(grid, ctx.map.obstacles, placed, body)
     k = p.agent_waypoints
     # Round trip start → w1 → … → wk → … → w1 → start, so a loop never crosses a wall.
     n_wp = 2 * k
     waypoints = np.full((n, n_wp, 2), np.nan)
-    order = np.argsort(cell_labels, kind="stable")
-    bounds = np.searchsorted(cell_labels[order], np.arange(cell_labels.max(initial=0) + 2))
-    # The cells of each region, gathered once per region: most pedestrians share the one big
-    # region, and gathering its cells (a fancy-index copy of most of the map) per pedestrian
-    # was the bulk of a reset.
-    regions: dict[int, NDArray[np.int64]] = {}
+    # The walkable region (8-connected, cells in row-major order) of each start: nearly all
+    # starts share the one big region, and labelling the whole map (then sorting its cells by
+    # label) for it was the bulk of a reset.
+    regions = MaskRegions(walkable)
     for i in range(n):
         chain = [starts[i]]
         r, c = grid.world_to_cell(starts[i])
-        lab = int(labels[r, c])
-        region_cells = regions.get(lab)
-        if region_cells is None:
-            region_cells = cells[order[bounds[lab] : bounds[lab + 1]]] if lab else cells[:0]
-            regions[lab] = region_cells
+        region_cells = regions.cells(r, c)
         for _ in range(k):
             chain.append(_next_waypoint(grid, walkable, region_cells, chain[-1], rng, p))
         trip = chain[1:] + chain[-2::-1]
@@ -276,6 +269,43 @@ def place_pedestrians(
     )
 
 
+def walkable_mask(
+    grid: OccupancyGrid,
+    map_obstacles: Sequence[Obstacle],
+    placed: Sequence[Obstacle],
+    body: float,
+) -> NDArray[np.bool_]:
+    """``(H, W)`` bool: free cells whose centre is more than ``body`` (m) from every blocked cell.
+
+    Blocked are the map's non-free cells and the cells under any obstacle footprint;
+    distances are :func:`~arena.tasks.sampling.clearance_map`'s. The map's own part is
+    computed once per map (:func:`~arena.tasks.sampling.grid_memo`); this episode's obstacles
+    then only clear the cells near them, which gives the same mask as thresholding the
+    clearance map of all blocked cells (distances to a union are the minimum of the parts').
+    """
+    polys = tuple(np.asarray(o.polygon, dtype=np.float64) for o in map_obstacles)
+    key = ("walkable", float(body), tuple((q.shape, q.tobytes()) for q in polys))
+
+    def static_part() -> NDArray[np.bool_]:
+        blocked = grid.occupied | ~grid.free
+        if polys:
+            blocked = blocked | polygon_mask(grid, list(polys))
+        walkable = (clearance_map(grid, blocked) > body) & grid.free
+        walkable.setflags(write=False)
+        return walkable
+
+    walkable = grid_memo(grid, key, static_part).copy()
+    cells = []
+    for o in placed:
+        window = polygon_window(grid, o.polygon)
+        if window is not None:
+            r0, c0, win = window
+            cells.append(np.argwhere(win) + np.array([r0, c0]))
+    if cells:
+        clear_near(walkable, np.concatenate(cells), max_blocked_sq(grid.resolution, body))
+    return walkable
+
+
 def _next_waypoint(
     grid: OccupancyGrid,
     walkable: NDArray[np.bool_],
@@ -288,58 +318,94 @@ def _next_waypoint(
     lo, hi = p.agent_leg_length
     if len(region_cells) == 0:
         return np.array(prev, dtype=np.float64)
+    ax, ay = float(prev[0]), float(prev[1])
+    ox, oy = float(grid.origin[0]), float(grid.origin[1])
+    out = np.empty(2, dtype=np.float64)
     for near_ok in (False, True):  # second pass: any visible cell ≥ 0.5 m away
+        d_min, d_max = (min(lo, 0.5), np.inf) if near_ok else (lo, hi)
         for _ in range(p.max_attempts // 20 + 1):
-            batch = region_cells[rng.integers(len(region_cells), size=64)]
-            pts = jitter(grid, batch, rng)
-            d = np.hypot(*(pts - prev).T)
-            ok = (d >= min(lo, 0.5)) if near_ok else (d >= lo) & (d <= hi)
-            m = _first_visible(
-                pts, ok, float(prev[0]), float(prev[1]), float(grid.origin[0]),
-                float(grid.origin[1]), float(grid.resolution), grid.height, grid.width, walkable,
-            )
-            if m >= 0:
-                return np.array(pts[m], dtype=np.float64)
+            # The draws of `jitter(grid, region_cells[pick], rng)`, in its order.
+            pick = rng.integers(len(region_cells), size=64)
+            u = rng.uniform(-0.5, 0.5, size=(64, 2))
+            if _pick_waypoint(
+                region_cells, pick, u, ax, ay, float(d_min), float(d_max), bool(near_ok),
+                ox, oy, float(grid.resolution), grid.height, grid.width, walkable, out,
+            ):
+                return out
     # No visible waypoint (a tiny enclosed pocket): stay put rather than cross a wall.
     return np.array(prev, dtype=np.float64)
 
 
 @njit(cache=True)
-def _first_visible(
-    pts: NDArray[np.float64],
-    ok: NDArray[np.bool_],
+def _pick_waypoint(
+    region_cells: NDArray[np.int64],
+    pick: NDArray[np.int64],
+    u: NDArray[np.float64],
     ax: float,
     ay: float,
+    d_min: float,
+    d_max: float,
+    near_ok: bool,
     ox: float,
     oy: float,
     res: float,
     height: int,
     width: int,
     allowed: NDArray[np.bool_],
-) -> int:
-    """Index of the first ``ok`` point in line of sight of ``(ax, ay)``, or -1.
+    out: NDArray[np.float64],
+) -> bool:
+    """One batch of :func:`_next_waypoint`: jitter, leg-length filter, first visible candidate.
 
-    :func:`~arena.tasks.sampling.line_of_sight` for a batch of candidates, operation for
-    operation (``np.linspace`` sample parameters ``i · (1/k)`` with the last exactly 1, the
-    same cell flooring), so the chosen waypoints are bit-identical; a reset tests thousands
-    of candidate legs, which cost ~60 µs each as separate numpy calls.
+    Candidate ``m`` is ``cell_to_world(region_cells[pick[m]]) + u[m] · res`` and qualifies if
+    its distance ``d`` from ``(ax, ay)`` is ``d ≥ d_min`` (and ``d ≤ d_max`` unless
+    ``near_ok``) and it is in line of sight (:func:`_visible`). The float operations are those
+    of :func:`~arena.tasks.sampling.jitter` and ``np.hypot``, in the same order, so the
+    waypoint is bit-identical; one batch used to cost a dozen numpy calls.
+    Writes the first qualifying candidate into ``out`` ``(2,)`` and returns whether one did.
     """
-    for m in range(pts.shape[0]):
-        if not ok[m]:
+    for m in range(pick.shape[0]):
+        cell = pick[m]
+        px = (ox + (float(region_cells[cell, 1]) + 0.5) * res) + u[m, 0] * res
+        py = (oy + (float(region_cells[cell, 0]) + 0.5) * res) + u[m, 1] * res
+        dx = px - ax
+        dy = py - ay
+        d = np.hypot(dx, dy)
+        if not (d >= d_min and (near_ok or d <= d_max)):
             continue
-        dx = pts[m, 0] - ax
-        dy = pts[m, 1] - ay
-        length = np.hypot(dx, dy)
-        k = max(int(np.ceil(length / (res / 3.0))), 1)
-        step = 1.0 / k
-        visible = True
-        for i in range(k + 1):
-            t = 1.0 if i == k else float(i) * step + 0.0
-            col = int(np.floor((ax + t * dx - ox) / res))
-            row = int(np.floor((ay + t * dy - oy) / res))
-            if row < 0 or row >= height or col < 0 or col >= width or not allowed[row, col]:
-                visible = False
-                break
-        if visible:
-            return m
-    return -1
+        if _visible(ax, ay, dx, dy, d, ox, oy, res, height, width, allowed):
+            out[0] = px
+            out[1] = py
+            return True
+    return False
+
+
+@njit(cache=True)
+def _visible(
+    ax: float,
+    ay: float,
+    dx: float,
+    dy: float,
+    length: float,
+    ox: float,
+    oy: float,
+    res: float,
+    height: int,
+    width: int,
+    allowed: NDArray[np.bool_],
+) -> bool:
+    """Whether the segment from ``(ax, ay)`` by ``(dx, dy)`` (``length`` m) stays in ``allowed``.
+
+    :func:`~arena.tasks.sampling.line_of_sight` operation for operation (``np.linspace``
+    sample parameters ``i · (1/k)`` with the last exactly 1, the same cell flooring), so the
+    chosen waypoints are bit-identical; a reset tests thousands of candidate legs, which cost
+    ~60 µs each as separate numpy calls.
+    """
+    k = max(int(np.ceil(length / (res / 3.0))), 1)
+    step = 1.0 / k
+    for i in range(k + 1):
+        t = 1.0 if i == k else float(i) * step + 0.0
+        col = int(np.floor((ax + t * dx - ox) / res))
+        row = int(np.floor((ay + t * dy - oy) / res))
+        if row < 0 or row >= height or col < 0 or col >= width or not allowed[row, col]:
+            return False
+    return True
