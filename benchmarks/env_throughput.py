@@ -10,9 +10,8 @@ resets included (an episode ends on arrival, contact, the 60 s timeout or 500 st
 * ``single``: one :class:`~arena.learn.env.SocialNavEnv` (native2d, the full crowd with social
   states, the reference simulator), one core.
 * ``batched N``: :class:`~arena.learn.batched.BatchedSocialNavEnv` with ``N`` worlds stepped
-  together (batched lidar/contacts/social-force kernels), ``--threads`` numba threads, the next
-  episode of each world drawn ahead by one helper process (``--prefetch 1``, as training does;
-  ``--prefetch 0`` draws in-process); the figure is the sum over worlds (N env steps per call).
+  together (batched lidar/contacts/social-force kernels), ``--threads`` numba threads; the
+  figure is the sum over worlds (N env steps per call).
 
 Targets (issue 7, 2 cores): >= 3,000 steps/s single, >= 20,000 steps/s batched (16 and 64).
 """
@@ -60,10 +59,10 @@ def single(steps: int) -> float:
     return steps / (time.perf_counter() - t0)
 
 
-def batched(n: int, steps: int, prefetch: int) -> float:
+def batched(n: int, steps: int) -> float:
     from arena.learn.batched import BatchedSocialNavEnv
 
-    env = BatchedSocialNavEnv(None, OVERRIDES, num_envs=n, prefetch=prefetch)
+    env = BatchedSocialNavEnv(None, OVERRIDES, num_envs=n)
     env.reset(seed=0)
     env.action_space.seed(0)
     for _ in range(20):
@@ -72,9 +71,7 @@ def batched(n: int, steps: int, prefetch: int) -> float:
     t0 = time.perf_counter()
     for _ in range(calls):
         env.step(env.action_space.sample())
-    rate = calls * n / (time.perf_counter() - t0)
-    env.close()
-    return rate
+    return calls * n / (time.perf_counter() - t0)
 
 
 def main() -> None:
@@ -83,9 +80,6 @@ def main() -> None:
     ap.add_argument("--worlds", type=int, nargs="+", default=[16, 64])
     ap.add_argument("--threads", type=int, default=2, help="numba threads (batched)")
     ap.add_argument("--skip-single", action="store_true")
-    ap.add_argument("--prefetch", type=int, default=1,
-                    help="batched: episodes per world drawn ahead by a helper process "
-                    "(learning.train.prefetch_episodes; 0: drawn in-process)")
     args = ap.parse_args()
     import numba
 
@@ -96,9 +90,9 @@ def main() -> None:
               f"(target 3,000)")
     numba.set_num_threads(min(args.threads, numba.config.NUMBA_NUM_THREADS))
     for n in args.worlds:
-        rate = batched(n, max(args.steps, 20 * n), args.prefetch)
-        print(f"BatchedSocialNavEnv N={n:<3d} ({numba.get_num_threads()} threads, "
-              f"prefetch {args.prefetch}): {rate:8.0f} steps/s  (target 20,000)")
+        rate = batched(n, max(args.steps, 20 * n))
+        print(f"BatchedSocialNavEnv N={n:<3d} ({numba.get_num_threads()} threads):     "
+              f"{rate:8.0f} steps/s  (target 20,000)")
     sys.stdout.flush()
 
 
