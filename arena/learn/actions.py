@@ -67,6 +67,8 @@ class ActionDecoder:
             self.table = np.column_stack([vw[:, 0], np.zeros(len(vw)), vw[:, 1]])
             # clipped once: clipping is elementwise, so clip(table)[idx] == clip(table[idx])
             self._clipped_table = np.clip(self.table, self.low, self.high)
+            # its rows as (1, 3) arrays, for one integer action (the single env's case)
+            self._clipped_rows = [row[None] for row in self._clipped_table]
             self.space = spaces.Discrete(len(self.table))
         else:
             if self.holonomic:
@@ -88,6 +90,12 @@ class ActionDecoder:
             actions: discrete indices ``(N,)`` or continuous actions ``(N, d)``.
         """
         if self.table is not None:
+            if isinstance(actions, int | np.integer):
+                # one index: a copy of its row (list indexing wraps negative indices and
+                # raises IndexError as numpy's fancy indexing does), one numpy call instead
+                # of three
+                row: FloatArray = self._clipped_rows[actions].copy()
+                return row
             idx = np.asarray(actions, dtype=np.int64).reshape(-1)
             table_cmd: FloatArray = self._clipped_table[idx]  # a fresh array (fancy indexing)
             return table_cmd

@@ -70,7 +70,6 @@ from collections.abc import Sequence
 from typing import Any, ClassVar, SupportsFloat
 
 import gymnasium as gym
-import numpy as np
 
 from arena.learn.driver import ConfigLike, EpisodeDriver, action_period_fps, resolve_config
 from arena.robots.model import RobotModel
@@ -118,15 +117,17 @@ class SocialNavEnv(gym.Env[Any, Any]):
         """Hold ``action`` for one action period."""
         if not self._started:
             raise RuntimeError("call reset() before step()")
-        res = self.driver.step(np.asarray(action)[None, ...])
+        # ActionDecoder.decode reshapes one action to a batch of one itself
+        res = self.driver.step(action)
         info = self.driver.info(goal_distance=res.goal_distance)
         info["outcome"] = res.outcomes[0]
         info["is_success"] = res.outcomes[0] == "success"  # SB3 logs rollout/success_rate
-        info["reward_terms"] = {k: float(v[0]) for k, v in res.reward.terms.items()}
-        info["collision"] = bool(res.collision[0])
+        # .item(): the Python float/bool of a (1,) array in one call
+        info["reward_terms"] = {k: v.item() for k, v in res.reward.terms.items()}
+        info["collision"] = res.collision.item()
         obs = self.driver.obs_builder.single(res.obs)
         return (
-            obs, float(res.reward.total[0]), bool(res.terminated[0]), bool(res.truncated[0]), info
+            obs, res.reward.total.item(), res.terminated.item(), res.truncated.item(), info
         )
 
     def render(self) -> Any:

@@ -37,6 +37,7 @@ float32 vector.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,6 +112,30 @@ def to_robot_frame(vectors: FloatArray, headings: FloatArray) -> FloatArray:
     return np.stack([c * x + s * y, -s * x + c * y], axis=-1)
 
 
+def _as_lists(
+    bounds: tuple[FloatArray, FloatArray] | None,
+) -> tuple[list[float], list[float]]:
+    """``(low, high)`` arrays as Python lists (empty when ``None``)."""
+    if bounds is None:
+        return [], []
+    return bounds[0].tolist(), bounds[1].tolist()
+
+
+def _clip_one(values: FloatArray, lo: list[float], hi: list[float]) -> NDArray[np.float32]:
+    """``values.clip(lo, hi).astype(float32)`` of one row ``(1, d)``, the same bits.
+
+    numpy's float clip is ``min(max(x, lo), hi)`` with ``max(a, b) = a if isnan(a) or a > b
+    else b`` and ``min(a, b) = a if isnan(a) or a < b else b`` (so ``clip(−0.0, 0.0, …)`` is
+    ``0.0`` and NaN passes), written out here on Python floats: one ``tolist`` and one
+    ``np.array`` instead of ``clip``'s Python wrapper, its ufunc and ``astype``.
+    """
+    out: list[float] = []
+    for x, low, high in zip(values.tolist()[0], lo, hi, strict=True):
+        v = x if (x != x or x > low) else low
+        out.append(v if (v != v or v < high) else high)
+    return np.array([out], np.float32)
+
+
 class ObservationBuilder:
     """Observation space and batched construction for one robot model.
 
@@ -176,6 +201,7 @@ class ObservationBuilder:
         self.dict_space = spaces.Dict(parts)
         self.keys = tuple(self.dict_space.keys())  # the order flatten_space uses
         self._lidar = "lidar" in parts
+        self._people = config.pedestrians.enabled or config.semantic.enabled
         self._goal = "goal" in parts
         # float64 copies of the last_action bounds: the float32 arrays would make each clip cast
         la = parts.get("last_action")
@@ -186,6 +212,13 @@ class ObservationBuilder:
         self._velocity_bounds: tuple[FloatArray, FloatArray] | None = (
             (ve.low.astype(np.float64), ve.high.astype(np.float64)) if ve is not None else None
         )
+        # operands and results (dx, dy, ρ, atan2) of the one-world goal path, see _goal_single;
+        # the (1,) views are made once (each costs a numpy call)
+        buf = np.zeros((4, 1))
+        self._goal_views = (buf[0], buf[1], buf[2], buf[3], buf[2:, 0])
+        # the same bounds as lists, for the one-world path (_clip_one)
+        self._action_bounds_l = _as_lists(self._action_bounds)
+        self._velocity_bounds_l = _as_lists(self._velocity_bounds)
         self.space: spaces.Space[object] = (
             spaces.flatten_space(self.dict_space) if config.flatten else self.dict_space
         )
@@ -199,24 +232,56 @@ class ObservationBuilder:
         if self._lidar:
             out["lidar"] = inp.scans.clip(0.0, self.range_max).astype(np.float32)
         if self._goal:
-            rho, theta = _goal_rho_theta(inp.poses, inp.goals)
-            goal = np.empty((n, 2), np.float32)  # assignment rounds to float32 as astype does
-            goal[:, 0] = np.minimum(rho, cfg.goal_max_distance)
-            goal[:, 1] = theta
-            out["goal"] = goal
+            if n == 1:
+                rho_1, theta_1 = self._goal_single(inp.poses, inp.goals)
+                # Python's min: numpy's np.minimum for non-NaN ρ, NaN ρ stays NaN in both
+                out["goal"] = np.array(
+                    [[min(rho_1, cfg.goal_max_distance), theta_1]], np.float32
+                )
+            else:
+                rho, theta = _goal_rho_theta(inp.poses, inp.goals)
+                goal = np.empty((n, 2), np.float32)  # assignment rounds to float32 as astype
+                goal[:, 0] = np.minimum(rho, cfg.goal_max_distance)
+                goal[:, 1] = theta
+                out["goal"] = goal
         if self._action_bounds is not None:
-            lo, hi = self._action_bounds
-            out["last_action"] = inp.last_action.clip(lo, hi).astype(np.float32)
+            if n == 1:
+                lo_l, hi_l = self._action_bounds_l
+                out["last_action"] = _clip_one(inp.last_action, lo_l, hi_l)
+            else:
+                lo, hi = self._action_bounds
+                out["last_action"] = inp.last_action.clip(lo, hi).astype(np.float32)
         if self._velocity_bounds is not None:
-            lo, hi = self._velocity_bounds
-            out["velocity"] = inp.twists.clip(lo, hi).astype(np.float32)
-        if cfg.pedestrians.enabled or cfg.semantic.enabled:
+            if n == 1:
+                lo_l, hi_l = self._velocity_bounds_l
+                out["velocity"] = _clip_one(inp.twists, lo_l, hi_l)
+            else:
+                lo, hi = self._velocity_bounds
+                out["velocity"] = inp.twists.clip(lo, hi).astype(np.float32)
+        if self._people:
             rel = to_robot_frame(inp.ped_pos - inp.poses[:, None, :2], inp.poses[:, 2])
             if cfg.pedestrians.enabled:
                 out.update(self._pedestrians(inp, rel, n))
             if cfg.semantic.enabled:
                 out["semantic"] = self._semantic(inp, rel, n)
         return out
+
+    def _goal_single(self, poses: FloatArray, goals: FloatArray) -> tuple[float, float]:
+        """:func:`_goal_rho_theta` of world 0 as floats ``(ρ m, θ rad)``, the same bits.
+
+        ``np.hypot``/``np.arctan2`` (on preallocated ``(1,)`` buffers: ``math.hypot`` and
+        ``math.atan2`` round differently from numpy's kernels) and Python float arithmetic
+        for the rest (``+ − %`` round as numpy's, ``%`` takes the divisor's sign in both).
+        """
+        px, py, heading = poses.tolist()[0]
+        gx, gy = goals.tolist()[0][:2]
+        dx, dy, rho_out, angle_out, results = self._goal_views
+        dx[0] = gx - px
+        dy[0] = gy - py
+        np.hypot(dx, dy, out=rho_out)
+        np.arctan2(dy, dx, out=angle_out)
+        rho, angle = results.tolist()
+        return rho, (angle - heading + math.pi) % (2 * math.pi) - math.pi
 
     def _robot_world_velocity(self, inp: ObsInput) -> FloatArray:
         c, s = np.cos(inp.poses[:, 2]), np.sin(inp.poses[:, 2])

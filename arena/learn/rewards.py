@@ -4,7 +4,10 @@ Each term is a small class registered in :data:`REWARD_TERMS` with a pydantic ``
 holding Arena's default (``rewards/constants.py``) and a ``__call__`` that maps a
 :class:`RewardInput` (arrays with a leading world axis ``N``) to a :class:`TermResult`.
 A :class:`RewardFunction` sums the configured terms like force terms and also returns each
-term's share, for logging. A batched environment reuses them unchanged.
+term's share, for logging. A batched environment reuses them unchanged. For the single
+environment most terms also have a ``single`` method, the same formula on Python floats
+(:class:`SingleRewardInput`, :meth:`RewardFunction.single`), bit-identical and several times
+cheaper than numpy on ``(1,)`` arrays.
 
 Reward files (``arena/learn/data/rewards/<name>.yaml``, or an inline mapping) list
 ``term_name: {params}``; besides a term's own parameters each block may hold
@@ -25,7 +28,7 @@ specs list the magnitude 0.01; every shipped file penalises).
 from __future__ import annotations
 
 import enum
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
@@ -116,6 +119,36 @@ class RewardInput:
         return np.asarray(self.min_range <= self.safe_dist)
 
 
+@dataclass(slots=True, eq=False)
+class SingleRewardInput:
+    """:class:`RewardInput` of one world as Python scalars (the single env's fast path).
+
+    Same meaning and units as the :class:`RewardInput` fields of the same names, without the
+    pedestrian arrays: ``batched`` returns the full ``N = 1`` :class:`RewardInput` for terms
+    that have no :meth:`single` method (those on pedestrians, those whose numpy kernels may
+    round differently from Python's ``math``). ``action`` and ``prev_action`` are
+    ``(vx m/s, vy m/s, ω rad/s)``.
+    """
+
+    action: tuple[float, float, float]
+    prev_action: tuple[float, float, float]
+    goal_distance: float
+    prev_goal_distance: float
+    goal_jump: float
+    goal_radius: float
+    goal_reached: bool
+    min_range: float
+    robot_radius: float
+    safe_dist: float
+    collision: bool
+    heading: float
+    prev_heading: float
+    dt: float
+    step: int
+    max_steps: int
+    batched: Callable[[], RewardInput]
+
+
 @dataclass(frozen=True, eq=False)
 class TermResult:
     """A term's output: ``reward`` ``(N,)`` and ``done`` ``(N,)`` bool with its ``reason``."""
@@ -126,7 +159,14 @@ class TermResult:
 
 
 class RewardTerm(Protocol):
-    """One reward unit."""
+    """One reward unit.
+
+    A term may also define ``single(inp: SingleRewardInput) -> (reward, done, reason)``, the
+    same formula on Python floats for one world; it must return the bits ``__call__`` returns
+    for ``N = 1`` (only ``+ − * /``, comparisons and ``abs``, in the same order: IEEE float64
+    operations round alike in numpy and Python, transcendental functions need not).
+    :meth:`RewardFunction.single` uses it when present.
+    """
 
     def __call__(self, inp: RewardInput) -> TermResult:
         """Rewards ``(N,)`` for ``N`` worlds."""
@@ -172,6 +212,12 @@ class GoalReachedTerm:
         hit = inp.goal_reached
         return _result(hit * self.params.reward, hit, DoneReason.SUCCESS)
 
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        hit = inp.goal_reached
+        # float(bool) * reward as numpy's bool -> float64 cast (False * −x is −0.0 in both)
+        return float(hit) * self.params.reward, hit, DoneReason.SUCCESS
+
 
 @REWARD_TERMS.register("collision")
 class CollisionTerm:
@@ -194,6 +240,13 @@ class CollisionTerm:
             hit |= inp.min_range <= inp.robot_radius + self.params.bumper_zone
         return _result(hit * self.params.reward, hit, DoneReason.COLLISION)
 
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        hit = inp.collision
+        if self.params.from_laser:
+            hit = hit or inp.min_range <= inp.robot_radius + self.params.bumper_zone
+        return float(hit) * self.params.reward, hit, DoneReason.COLLISION
+
 
 @REWARD_TERMS.register("safe_distance")
 class SafeDistanceTerm:
@@ -210,6 +263,11 @@ class SafeDistanceTerm:
     def __call__(self, inp: RewardInput) -> TermResult:
         """Rewards ``(N,)`` for the ``N`` worlds of ``inp``."""
         return _result(inp.safe_dist_breached * self.params.reward)
+
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        breached = inp.min_range <= inp.safe_dist
+        return float(breached) * self.params.reward, False, DoneReason.NONE
 
 
 @REWARD_TERMS.register("no_movement")
@@ -228,6 +286,11 @@ class NoMovementTerm:
     def __call__(self, inp: RewardInput) -> TermResult:
         """Rewards ``(N,)`` for the ``N`` worlds of ``inp``."""
         return _result((np.abs(inp.action[:, 0]) <= self.params.tolerance) * self.params.reward)
+
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        idle = abs(inp.action[0]) <= self.params.tolerance
+        return float(idle) * self.params.reward, False, DoneReason.NONE
 
 
 @REWARD_TERMS.register("approach_goal")
@@ -251,6 +314,14 @@ class ApproachGoalTerm:
         r = np.where(delta > 0, p.pos_factor, p.neg_factor) * delta
         return _result(np.where(inp.goal_jump >= p.goal_update_threshold, 0.0, r))
 
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        p = self.params
+        if inp.goal_jump >= p.goal_update_threshold:
+            return 0.0, False, DoneReason.NONE
+        delta = inp.prev_goal_distance - inp.goal_distance
+        return (p.pos_factor if delta > 0 else p.neg_factor) * delta, False, DoneReason.NONE
+
 
 @REWARD_TERMS.register("distance_travelled")
 class DistanceTravelledTerm:
@@ -273,6 +344,12 @@ class DistanceTravelledTerm:
         v = a[:, 0] * p.lin_vel_scalar + a[:, 2] * p.ang_vel_scalar
         return _result(-v * p.consumption_factor)
 
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        p = self.params
+        v = abs(inp.action[0]) * p.lin_vel_scalar + abs(inp.action[2]) * p.ang_vel_scalar
+        return -v * p.consumption_factor, False, DoneReason.NONE
+
 
 @REWARD_TERMS.register("reverse_drive")
 class ReverseDriveTerm:
@@ -291,6 +368,12 @@ class ReverseDriveTerm:
         """Rewards ``(N,)`` for the ``N`` worlds of ``inp``."""
         v = inp.action[:, 0]
         return _result(((v < 0) & (v < self.params.threshold)) * self.params.reward)
+
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        v = inp.action[0]
+        hit = v < 0 and v < self.params.threshold
+        return float(hit) * self.params.reward, False, DoneReason.NONE
 
 
 @REWARD_TERMS.register("abrupt_velocity_change")
@@ -333,6 +416,15 @@ class TwoFactorVelocityDifferenceTerm:
         """Rewards ``(N,)`` for the ``N`` worlds of ``inp``."""
         d = inp.action - inp.prev_action
         return _result(-(self.params.alpha * d[:, 0] ** 2 + self.params.beta * d[:, 2] ** 2))
+
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        # numpy's ``x ** 2`` is ``x * x`` (np.square), not pow
+        d0 = inp.action[0] - inp.prev_action[0]
+        d2 = inp.action[2] - inp.prev_action[2]
+        return -(self.params.alpha * (d0 * d0) + self.params.beta * (d2 * d2)), False, (
+            DoneReason.NONE
+        )
 
 
 @REWARD_TERMS.register("ped_type_safety_distance")
@@ -442,6 +534,13 @@ class RotationPenaltyTerm:
         w = np.abs(inp.action[:, 2])
         return _result(np.where(w > self.params.threshold, -self.params.factor * w, 0.0))
 
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        w = abs(inp.action[2])
+        return (-self.params.factor * w if w > self.params.threshold else 0.0), False, (
+            DoneReason.NONE
+        )
+
 
 @REWARD_TERMS.register("max_steps_exceeded")
 class MaxStepsExceededTerm:
@@ -459,6 +558,11 @@ class MaxStepsExceededTerm:
         """Rewards ``(N,)`` for the ``N`` worlds of ``inp``."""
         hit = inp.step >= inp.max_steps
         return _result(hit * self.params.reward, hit, DoneReason.STEP_LIMIT)
+
+    def single(self, inp: SingleRewardInput) -> tuple[float, bool, DoneReason]:
+        """``(reward, done, reason)`` of one world (:meth:`__call__`'s bits)."""
+        hit = inp.step >= inp.max_steps
+        return float(hit) * self.params.reward, hit, DoneReason.STEP_LIMIT
 
 
 # -- composition --------------------------------------------------------------------------------
@@ -581,6 +685,11 @@ class RewardFunction:
             (name, term, self.weights[name], self.on_violation[name])
             for name, term in self.terms.items()
         ]
+        # (term, its ``single`` method or None, weight, on_violation) for :meth:`single`
+        self._single_plan: list[tuple[RewardTerm, Any, float, bool]] = [
+            (term, getattr(term, "single", None), weight, on_violation)
+            for _, term, weight, on_violation in self._plan
+        ]
 
     @property
     def names(self) -> tuple[str, ...]:
@@ -641,6 +750,50 @@ class RewardFunction:
         if total is None or done is None or reason is None:
             total, done, reason = _accumulators(n, total_1, done_1, reason_1)
         return RewardOutput(total, parts, done, reason)
+
+    def single(self, inp: SingleRewardInput) -> RewardOutput:
+        """:meth:`__call__` for one world given as scalars; the same output, bit for bit.
+
+        Terms with a ``single`` method run on Python floats; the others on
+        ``inp.batched()`` (built at most once). Per term the share is ``weight · reward`` (no
+        multiplication by a weight of 1, as :meth:`__call__`), ``0.0`` for a term switched off
+        during a safe-distance breach, and the shares are summed from ``0.0`` in file order: the
+        float64 operations of :meth:`__call__`, so the same bits. This path exists because the
+        single env evaluates the reward every step, where numpy's per-call cost on ``(1,)``
+        arrays is most of the work.
+        """
+        total, done, reason = 0.0, False, 0
+        breached: bool | None = None  # computed once and only when a term needs it
+        batched: RewardInput | None = None
+        shares: list[float] = []
+        for term, single, weight, on_violation in self._single_plan:
+            if single is not None:
+                r, fired, why = single(inp)
+            else:
+                if batched is None:
+                    batched = inp.batched()
+                res = term(batched)
+                r, fired, why = float(res.reward[0]), bool(res.done[0]), res.reason
+            if weight != 1.0:
+                r = r * weight
+            if not on_violation:
+                if breached is None:
+                    breached = inp.min_range <= inp.safe_dist
+                if breached:
+                    r, fired = 0.0, False
+            shares.append(r)
+            total += r
+            if fired:
+                done = True
+                reason = max(reason, int(why))
+        # a (1,) array per share (cheaper than rows of one (k, 1) array: row views cost more)
+        parts = {
+            name: np.array([r], np.float64)
+            for name, r in zip(self.terms, shares, strict=True)
+        }
+        return RewardOutput(
+            np.array([total]), parts, np.array([done]), np.array([reason], dtype=np.int64)
+        )
 
 
 def _accumulators(

@@ -1,6 +1,7 @@
 """Action spaces and decoding."""
 
 import numpy as np
+import pytest
 from gymnasium import spaces
 
 from arena.learn.actions import ActionDecoder, custom_grid
@@ -12,6 +13,24 @@ def test_robot_discretization_uses_the_presets_list():
     dec = ActionDecoder(ActionConfig(type="discrete", discretization="robot"), load_robot("jackal"))
     assert dec.space == spaces.Discrete(7)
     np.testing.assert_allclose(dec.decode([0, 2]), [[0.30, 0, 0], [0.15, 0, 0.35]])
+
+
+def test_one_integer_action_decodes_as_a_batch_of_one():
+    """The integer shortcut of ``decode``: the batched rows, fresh arrays, the same errors."""
+    dec = ActionDecoder(ActionConfig(type="discrete", discretization="robot"), load_robot("jackal"))
+    n = dec.space.n
+    for i in [*range(-n, n), *(np.int64(k) for k in range(n)), True]:
+        one = dec.decode(i)
+        batch = dec.decode(np.asarray(i)[None])
+        assert one.shape == (1, 3) and one.dtype == np.float64
+        assert one.tobytes() == batch.tobytes()
+        one[:] = 99.0  # callers write into the command (inactive robots): must not leak
+        assert dec.decode(i).tobytes() == batch.tobytes()
+    for bad in (n, -n - 1):
+        with pytest.raises(IndexError):
+            dec.decode(bad)
+        with pytest.raises(IndexError):
+            dec.decode([bad])
 
 
 def test_custom_grid_includes_stop():

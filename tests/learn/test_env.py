@@ -138,3 +138,43 @@ def test_vector_envs(kind):
         assert rew.shape == (2,) and np.all(np.isfinite(rew))
     finally:
         vec.close()
+
+
+@pytest.mark.parametrize("reward", ["default", "rule_13", "base_semantic"])
+def test_one_robot_scalar_reward_input_matches_the_batched_input(reward):
+    """The driver's scalar reward input carries the bits of its batched input, field by field,
+    and the scalar reward path returns the batched reward output."""
+    import dataclasses
+
+    from arena.learn.rewards import RewardInput
+
+    env = SocialNavEnv(small_cfg(f"learning.env.reward={reward}"), robot=small_robot())
+    fn = env.driver.reward_fn
+    single = fn.single
+    seen = []
+
+    def checked(inp):
+        batch = inp.batched()
+        assert isinstance(batch, RewardInput)
+        for f in dataclasses.fields(inp):
+            if f.name == "batched":
+                continue
+            got = np.asarray(getattr(inp, f.name), dtype=getattr(batch, f.name).dtype)
+            assert got.tobytes() == getattr(batch, f.name)[0].tobytes(), f.name
+        out = single(inp)
+        ref = fn(batch)
+        assert out.total.tobytes() == ref.total.tobytes()
+        assert out.done.tolist() == ref.done.tolist()
+        assert out.reason.tolist() == ref.reason.tolist()
+        assert all(out.terms[k].tobytes() == v.tobytes() for k, v in ref.terms.items())
+        seen.append(inp.step)
+        return out
+
+    fn.single = checked
+    env.reset(seed=2)
+    rng = np.random.default_rng(0)
+    for _ in range(60):
+        _, _, term, trunc, _ = env.step(rng.integers(env.action_space.n))
+        if term or trunc:
+            env.reset()
+    assert len(seen) == 60

@@ -1,5 +1,6 @@
 """Observation construction for N worlds."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -23,6 +24,49 @@ def make_input(poses, peds=(), vels=None, kinds=None, states=None, beams=24, sta
         ped_state=np.zeros((n, m), np.int64) if states is None else np.asarray(states),
         ped_mask=np.ones((n, m), bool),
     )
+
+
+def test_one_world_goal_matches_the_batched_rows_bit_for_bit():
+    """The scalar goal path of ``build`` for N = 1 gives each row of the batched path."""
+    rng = np.random.default_rng(0)
+    b = ObservationBuilder(ObservationConfig(goal_max_distance=4.0), small_robot())
+    n = 400
+    poses = np.column_stack([rng.normal(size=(n, 2)) * 3, rng.uniform(-7, 7, n)])
+    poses[:20, :2] = 0.0  # goal under the robot: ρ = 0, θ from atan2(±0, ±0)
+    poses[20:40, 2] = np.pi * rng.choice([-3, -1, 0, 1, 2], 20)
+    goals = np.where(rng.random((n, 2)) < 0.1, 0.0, rng.normal(size=(n, 2)) * 3)
+    inp = dataclasses.replace(make_input(poses), goals=goals)
+    batched = b.build(inp)["goal"]
+    for i in range(n):
+        one = dataclasses.replace(make_input(poses[i]), goals=goals[i : i + 1])
+        got = b.build(one)["goal"]
+        assert got.dtype == np.float32 and got.shape == (1, 2)
+        assert got.tobytes() == batched[i : i + 1].tobytes(), i
+
+
+def test_one_world_clipped_commands_match_the_batched_rows_bit_for_bit():
+    """``last_action`` and ``velocity`` for N = 1 (Python clip) equal the batched numpy clip,
+    signed zeros, NaN, infinities and the bounds themselves included."""
+    b = ObservationBuilder(ObservationConfig(velocity=True), small_robot())
+    lo, hi = b._action_bounds
+    special = [0.0, -0.0, math.nan, math.inf, -math.inf, *lo.tolist(), *hi.tolist()]
+    rng = np.random.default_rng(1)
+    n = 300
+    vals = np.where(
+        rng.random((2, n, 3)) < 0.4, rng.choice(special, (2, n, 3)), rng.normal(size=(2, n, 3))
+    )
+    inp = dataclasses.replace(
+        make_input(np.zeros((n, 3))), last_action=vals[0], twists=vals[1]
+    )
+    batched = b.build(inp)
+    for i in range(n):
+        one = dataclasses.replace(
+            make_input(np.zeros(3)), last_action=vals[0, i : i + 1], twists=vals[1, i : i + 1]
+        )
+        got = b.build(one)
+        for key in ("last_action", "velocity"):
+            assert got[key].dtype == np.float32 and got[key].shape == (1, 3)
+            assert got[key].tobytes() == batched[key][i : i + 1].tobytes(), (key, i)
 
 
 def test_goal_angle_is_zero_straight_ahead():

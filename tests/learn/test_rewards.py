@@ -13,6 +13,7 @@ from arena.learn.rewards import (
     DoneReason,
     RewardFunction,
     RewardInput,
+    SingleRewardInput,
     build_term,
     packaged_reward,
 )
@@ -277,3 +278,107 @@ def test_one_world_matches_each_world_of_a_batch(spec):
             assert single.reason.tolist() == out.reason[w : w + 1].tolist()
             for name, share in single.terms.items():
                 assert share.tobytes() == out.terms[name][w : w + 1].tobytes()
+
+
+def _single_of(batch: RewardInput, w: int) -> SingleRewardInput:
+    """World ``w`` of ``batch`` as the scalar input of :meth:`RewardFunction.single`."""
+    one = dataclasses.replace(
+        batch, **{f.name: getattr(batch, f.name)[w : w + 1] for f in dataclasses.fields(batch)}
+    )
+    a = batch.action[w].tolist()
+    p = batch.prev_action[w].tolist()
+    scalars = {
+        f.name: getattr(batch, f.name)[w].item()
+        for f in dataclasses.fields(SingleRewardInput)
+        if f.name not in ("action", "prev_action", "batched")
+    }
+    return SingleRewardInput(
+        action=(a[0], a[1], a[2]), prev_action=(p[0], p[1], p[2]), batched=lambda: one,
+        **scalars,
+    )
+
+
+def _random_batch(rng: np.random.Generator, n: int = 2) -> RewardInput:
+    """Random inputs (``n``: :func:`make_input`'s two worlds) with exact zeros, ties, signs."""
+    action = rng.choice([-1.0, -0.5, -0.0, 0.0, 0.05, 0.3, 1.7], (n, 3)) + rng.normal(
+        scale=rng.choice([0.0, 1.0]), size=(n, 3)
+    )
+    d = rng.random(n) * 5
+    return make_input(
+        action=action, prev_action=rng.normal(size=(n, 3)),
+        goal_distance=d, prev_goal_distance=np.where(rng.random(n) < 0.3, d, rng.random(n) * 5),
+        goal_jump=rng.choice([0.0, 1.0, 2.5, 3.0], n), goal_reached=rng.random(n) < 0.3,
+        min_range=rng.choice([0.3, 0.35, 0.8, 1.2], n) * rng.choice([1.0, 0.9], n),
+        collision=rng.random(n) < 0.3, heading=rng.uniform(-4, 4, n),
+        prev_heading=rng.uniform(-4, 4, n), step=rng.integers(495, 505, n),
+        ped_distance=rng.random((n, 3)) * 3, ped_kind=rng.integers(0, 3, (n, 3)),
+    )
+
+
+SCALAR_TERMS = [n for n in REWARD_TERMS.names() if hasattr(build_term(n), "single")]
+
+
+def test_most_terms_have_a_scalar_form():
+    """Terms without ``single`` (numpy powers/sums, per-pedestrian arrays) use the N = 1 arrays."""
+    assert set(REWARD_TERMS.names()) - set(SCALAR_TERMS) == {
+        "abrupt_velocity_change", "angular_vel_constraint", "ped_type_safety_distance",
+        "ped_type_collision", "ped_type_vel_constraint",
+    }
+
+
+@pytest.mark.parametrize("name", SCALAR_TERMS)
+def test_single_method_matches_the_batched_term_bit_for_bit(name):
+    """A term's scalar ``single`` returns the bits, done flag and reason of ``__call__``."""
+    t = build_term(name)
+    variants = [t]
+    if name == "collision":
+        variants.append(build_term(name, from_laser=True))
+    if name == "reverse_drive":
+        variants.append(build_term(name, threshold=-0.5))
+    rng = np.random.default_rng(7)
+    for term_ in variants:
+        for _ in range(150):
+            batch = _random_batch(rng)
+            res = term_(batch)
+            for w in range(batch.n):
+                r, done, reason = term_.single(_single_of(batch, w))
+                assert type(r) is float and type(done) is bool
+                assert np.array([r]).tobytes() == res.reward[w : w + 1].tobytes()
+                assert done == bool(res.done[w])
+                assert reason is res.reason
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [
+        "default", "rule_13", "rlca", "base_semantic",
+        {
+            "goal_reached": {"reward": 15, "weight": 0.5, "_on_safe_dist_violation": False},
+            "collision": {"reward": -10, "from_laser": True},
+            "safe_distance": {"weight": -1.5},
+            "approach_goal": {"_on_safe_dist_violation": False},
+            "ped_type_vel_constraint": {"_on_safe_dist_violation": False, "weight": 3.0},
+            "angular_vel_constraint": {"threshold": 0.5},
+            "rotation_penalty": {},
+            "no_movement": {},
+            "distance_travelled": {},
+            "max_steps_exceeded": {"weight": 2.0},
+        },
+    ],
+)
+def test_function_single_matches_the_batched_call_bit_for_bit(spec):
+    """:meth:`RewardFunction.single` (scalar terms + fallbacks) equals ``__call__`` on N = 1."""
+    fn = RewardFunction(spec)
+    rng = np.random.default_rng(3)
+    for _ in range(40):
+        batch = _random_batch(rng)
+        for w in range(batch.n):
+            inp = _single_of(batch, w)
+            ref = fn(inp.batched())
+            out = fn.single(inp)
+            assert out.total.tobytes() == ref.total.tobytes()
+            assert out.done.dtype == bool and out.done.tolist() == ref.done.tolist()
+            assert out.reason.dtype == np.int64 and out.reason.tolist() == ref.reason.tolist()
+            assert list(out.terms) == list(ref.terms)
+            for name, share in out.terms.items():
+                assert share.tobytes() == ref.terms[name].tobytes(), name
