@@ -615,3 +615,14 @@ def test_groups_edited_in_place_are_seen() -> None:
     fresh = ours(world, frame)
     for name in TERMS:
         assert again.forces[name].tobytes() == fresh.forces[name].tobytes(), name
+
+
+def test_nan_max_kernel_is_numpys_max() -> None:
+    """The obstacle reach's maximum radius, taken in the kernel, is ``ndarray.max``'s."""
+    from arena.crowd.models.pysocial import _nan_max
+
+    rng = np.random.default_rng(3)
+    cases = [rng.uniform(0.1, 0.6, n) for n in (1, 2, 7, 40)]
+    cases += [np.array([0.3, np.nan, 0.5]), np.array([np.nan]), np.array([0.2, 0.2, np.inf])]
+    for x in cases:
+        assert np.array_equal(_nan_max(x), x.max(), equal_nan=True)

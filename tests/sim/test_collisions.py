@@ -65,3 +65,77 @@ def test_hits_grid_with_given_bounds_matches():
     for _ in range(200):
         pose = rng.uniform([-0.5, -0.5, -np.pi], [4.5, 3.5, np.pi])
         assert hits_grid(grid, fp, pose, bounds=grid.bounds) == hits_grid(grid, fp, pose)
+
+
+def reference_hits_grid(grid, fp, pose):
+    """``hits_grid`` as it was before its compiled window test (NumPy throughout)."""
+    from arena.core.geometry import convex_polygon_overlaps_squares
+
+    x, y = float(pose[0]), float(pose[1])
+    xmin, ymin, xmax, ymax = grid.bounds
+    if not (xmin <= x < xmax and ymin <= y < ymax):
+        return True
+    r = fp.radius
+    if x - r < xmin or y - r < ymin or x + r > xmax or y + r > ymax:
+        pts = fp.world_polygon(pose)
+        if pts is None or (
+            pts[:, 0].min() < xmin
+            or pts[:, 1].min() < ymin
+            or pts[:, 0].max() > xmax
+            or pts[:, 1].max() > ymax
+        ):
+            return True
+    res = grid.resolution
+    col = int((x - grid.origin[0]) // res)
+    row = int((y - grid.origin[1]) // res)
+    if grid.distance[row, col] - res * np.sqrt(2.0) >= r:
+        return False
+    k = int(np.ceil(r / res)) + 1
+    r0, r1 = max(row - k, 0), min(row + k + 1, grid.height)
+    c0, c1 = max(col - k, 0), min(col + k + 1, grid.width)
+    rows, cols = np.nonzero(grid.occupied[r0:r1, c0:c1])
+    if rows.size == 0:
+        return False
+    cx = grid.origin[0] + (cols + c0 + 0.5) * res
+    cy = grid.origin[1] + (rows + r0 + 0.5) * res
+    half = 0.5 * res
+    if fp.polygon is None:
+        dx = np.maximum(np.abs(cx - x) - half, 0.0)
+        dy = np.maximum(np.abs(cy - y) - half, 0.0)
+        return bool(np.any(dx * dx + dy * dy < r * r))
+    poly = transform_points(fp.polygon, pose)
+    return bool(np.any(convex_polygon_overlaps_squares(poly, np.stack([cx, cy], axis=1), half)))
+
+
+def test_hits_grid_matches_the_numpy_reference_near_walls():
+    """The compiled circle test and the polygon's bounding-circle shortcut change no answer.
+
+    Poses are drawn near blocking cells (where the window test runs), including exactly
+    tangent circles (centres a radius from a cell edge) and a footprint whose radius is
+    smaller than its polygon (the shortcut must use the polygon's extent).
+    """
+    rng = np.random.default_rng(5)
+    occ = rng.random((50, 50)) < 0.04
+    grid = OccupancyGrid.from_occupied(occ, 0.05, origin=(-1.3, 0.7))
+    feet = [
+        Footprint.make(None, 0.25),
+        Footprint.make(rectangle(0.5, 0.43), 0.3),
+        Footprint.make(np.array([[0.3, 0.0], [-0.2, 0.2], [-0.2, -0.2]]), 0.3),
+        Footprint(rectangle(0.6, 0.2), 0.1),  # radius below the polygon's extent
+    ]
+    rows, cols = np.nonzero(occ)
+    answers = set()
+    for trial in range(3000):
+        fp = feet[trial % len(feet)]
+        q = rng.integers(rows.size)
+        cx = -1.3 + (cols[q] + 0.5) * 0.05
+        cy = 0.7 + (rows[q] + 0.5) * 0.05
+        if trial % 5 == 0:  # tangent to the cell's right edge
+            pose = np.array([cx + 0.025 + fp.radius, cy, rng.uniform(-np.pi, np.pi)])
+        else:
+            pose = np.array([*(np.array([cx, cy]) + rng.uniform(-0.6, 0.6, 2)), 0.0])
+            pose[2] = rng.uniform(-np.pi, np.pi)
+        want = reference_hits_grid(grid, fp, pose)
+        assert hits_grid(grid, fp, pose) == want, (trial, pose)
+        answers.add(want)
+    assert answers == {True, False}

@@ -304,7 +304,7 @@ class PySocialModel:
         n = len(s)
         # One block for the seven terms: the kernel fills it, the dict hands out its rows.
         forces = np.zeros((len(TERMS), n, 2))
-        terms = {k: forces[i] for i, k in enumerate(TERMS)}
+        terms = dict(zip(TERMS, forces, strict=True))  # rows: views of the block
         if n == 0:
             return ModelOutput(accelerations=np.zeros((0, 2)), forces=terms)
         pos = np.ascontiguousarray(s.positions, dtype=np.float64)
@@ -312,13 +312,13 @@ class PySocialModel:
         active = np.ascontiguousarray(frame.active, dtype=np.bool_)
 
         pi, pj = frame.neighbors.unique_pairs()
-        if not active.all():  # pairs of two inactive agents exert nothing on anyone
+        # pairs of two inactive agents exert nothing on anyone (count_nonzero: cheaper than all)
+        if np.count_nonzero(active) != active.shape[0]:
             keep = active[pi] | active[pj]
             pi, pj = pi[keep], pj[keep]
         self._social_term(pos, vel, pi, pj, forces[_SOCIAL])
 
         radii = self._agent_radii(s)
-        r_max = float(p.agent_radius) if p.agent_radius is not None else float(radii.max())
         order, starts = self._group_members(s.group) if p.enable_group else _NO_GROUPS
         ob = self._obstacles
         acc = np.empty((n, 2))
@@ -332,8 +332,6 @@ class PySocialModel:
             np.ascontiguousarray(frame.robots.positions, dtype=np.float64),
             np.ascontiguousarray(frame.robots.velocities, dtype=np.float64),
             radii,
-            # Slightly wider than the reach: the kernel applies PySocialForce's exact test.
-            p.obstacle_threshold + 2.0 * r_max + 1e-9,
             ob.xy,
             ob.cell_blocks,
             ob.block_lo,
@@ -429,12 +427,10 @@ class PySocialModel:
             )
             geo = wk.geo
             np.arctan2(geo[0, :c], geo[1, :c], out=wk.w[:c])
-            args = wk.args[: 4 * c].reshape(4, c)
-            ex = wk.ex[: 4 * c].reshape(4, c)
-            _pair_exponents(wk.w, wk.code, geo, c, p.n, p.n_prime, p.wrap_theta, args, wk.sg)
+            _pair_exponents(wk.w, wk.code, geo, c, p.n, p.n_prime, p.wrap_theta, wk.args, wk.sg)
             with np.errstate(under="ignore"):  # distant pairs: exp → 0 is the right answer
-                np.exp(args, out=ex)
-            _pair_accumulate(pi, pj, lo, hi, geo[4], geo[5], ex, wk.sg, out)
+                np.exp(wk.args[: 4 * c], out=wk.ex[: 4 * c])
+            _pair_accumulate(pi, pj, lo, hi, geo, wk.ex, wk.sg, out)
 
 
 _SOCIAL = TERMS.index("social")
@@ -500,8 +496,9 @@ class _PairWork:
     w: FloatArray
     """``(k,)`` wrapped angles (rad)."""
     args: FloatArray
-    """``(4k,)`` exponents, viewed as ``(4, c)`` for a block of ``c`` pairs: contiguous, so
-    that one SIMD ``exp`` loop covers them (per element the same function as row by row)."""
+    """``(4k,)`` exponents, ``(4, c)`` row-major in the first ``4c`` for a block of ``c`` pairs:
+    contiguous, so that one SIMD ``exp`` loop covers them (per element the same function as row
+    by row)."""
     ex: FloatArray
     """``(4k,)`` their exponentials, likewise."""
     sg: FloatArray
@@ -832,7 +829,8 @@ def _pair_exponents(
         n: angular decay n (1/m).
         n_prime: angular decay n' (1/m).
         wrap: θ wrapped into (−π, π] instead of PySocialForce's raw difference.
-        args: ``(4, ≥ m)`` out: exponents (braking, turning) for ``i``, then for ``j``.
+        args: ``(≥ 4m,)`` out: exponents, ``(4, m)`` row-major in the first ``4m``: braking and
+            turning for ``i``, then for ``j`` (one contiguous block for one ``exp`` call).
         sg: ``(2, ≥ m)`` out: ``sign θ`` for ``i`` and ``j``.
     """
     coincident = 0
@@ -855,10 +853,10 @@ def _pair_exponents(
         th_j = wq if wrap else th_j
         b = geo[3, q]
         bs = geo[2, q]
-        args[0, q] = bs - (n_prime * b * th_i) ** 2
-        args[1, q] = bs - (n * b * th_i) ** 2
-        args[2, q] = bs - (n_prime * b * th_j) ** 2
-        args[3, q] = bs - (n * b * th_j) ** 2
+        args[q] = bs - (n_prime * b * th_i) ** 2
+        args[1 * m + q] = bs - (n * b * th_i) ** 2
+        args[2 * m + q] = bs - (n_prime * b * th_j) ** 2
+        args[3 * m + q] = bs - (n * b * th_j) ** 2
         sg[0, q] = (th_i > 0.0) - (th_i < 0.0)
         sg[1, q] = (th_j > 0.0) - (th_j < 0.0)
         coincident += (cd & 16) != 0
@@ -872,10 +870,10 @@ def _pair_exponents(
             th_j = math.atan2(rty, rtx)
             b = geo[3, q]
             bs = geo[2, q]
-            args[0, q] = bs - (n_prime * b * th_i) ** 2
-            args[1, q] = bs - (n * b * th_i) ** 2
-            args[2, q] = bs - (n_prime * b * th_j) ** 2
-            args[3, q] = bs - (n * b * th_j) ** 2
+            args[q] = bs - (n_prime * b * th_i) ** 2
+            args[1 * m + q] = bs - (n * b * th_i) ** 2
+            args[2 * m + q] = bs - (n_prime * b * th_j) ** 2
+            args[3 * m + q] = bs - (n * b * th_j) ** 2
             sg[0, q] = (th_i > 0.0) - (th_i < 0.0)
             sg[1, q] = (th_j > 0.0) - (th_j < 0.0)
 
@@ -886,25 +884,30 @@ def _pair_accumulate(
     pj: IntArray,
     lo: int,
     hi: int,
-    tx: FloatArray,
-    ty: FloatArray,
+    geo: FloatArray,
     ex: FloatArray,
     sg: FloatArray,
     out: FloatArray,
 ) -> None:
-    """``exp(..)·t − sign(θ)·exp(..)·t⊥`` on ``i`` and, with ``t' = −t``, on ``j``."""
+    """``exp(..)·t − sign(θ)·exp(..)·t⊥`` on ``i`` and, with ``t' = −t``, on ``j``.
+
+    ``geo``: :func:`_pair_geometry`'s ``(6, ≥ m)`` rows (``t`` in rows 4, 5); ``ex``: the
+    exponentials of :func:`_pair_exponents`' ``args`` (``(4, m)`` row-major); ``sg``: its
+    signs; ``m = hi − lo`` pairs ``pi[lo:hi]``, ``pj[lo:hi]``; ``out`` ``(n, 2)``: added to.
+    """
+    m = hi - lo
     for p in range(lo, hi):
         q = p - lo
         i = pi[p]
         j = pj[p]
-        t_x = tx[q]
-        t_y = ty[q]
-        fv = ex[0, q]
-        fa = -sg[0, q] * ex[1, q]
+        t_x = geo[4, q]
+        t_y = geo[5, q]
+        fv = ex[q]
+        fa = -sg[0, q] * ex[m + q]
         out[i, 0] += fv * t_x - fa * t_y
         out[i, 1] += fv * t_y + fa * t_x
-        fv = ex[2, q]
-        fa = -sg[1, q] * ex[3, q]
+        fv = ex[2 * m + q]
+        fa = -sg[1, q] * ex[3 * m + q]
         out[j, 0] -= fv * t_x - fa * t_y
         out[j, 1] -= fv * t_y + fa * t_x
 
@@ -1113,7 +1116,6 @@ def _terms(
     rpos: FloatArray,
     rvel: FloatArray,
     radii: FloatArray,
-    reach: float,
     xy: FloatArray,
     cell_blocks: IntArray,
     block_lo: IntArray,
@@ -1146,8 +1148,8 @@ def _terms(
         active: ``(n,)`` agents that get forces.
         rpos: ``(r, 2)`` robot positions (m).
         rvel: ``(r, 2)`` robot world-frame velocities (m/s).
-        radii: ``(n,)`` agent radii in the obstacle term (m).
-        reach: obstacle search radius (m), a hair over ``threshold + 2·max(radii)``.
+        radii: ``(n ≥ 1,)`` agent radii in the obstacle term (m); their maximum sets the
+            obstacle search radius.
         xy: :attr:`_ObstacleIndex.xy` (no columns: no obstacles).
         cell_blocks: :attr:`_ObstacleIndex.cell_blocks`.
         block_lo: :attr:`_ObstacleIndex.block_lo`.
@@ -1186,6 +1188,8 @@ def _terms(
         )
         _scale(forces[r_], coef[_C_ROBOT_SCALE])
     if xy.shape[1] > 0:
+        # Slightly wider than the reach: _obstacle applies PySocialForce's exact test.
+        reach = coef[_C_OB_THRESHOLD] + 2.0 * _nan_max(radii) + 1e-9
         _obstacle(
             pos,
             radii,
@@ -1238,6 +1242,17 @@ def _terms(
             ay += forces[k, i, 1]
         acc[i, 0] = ax
         acc[i, 1] = ay
+
+
+@njit(cache=True)
+def _nan_max(x: FloatArray) -> float:
+    """``x.max()`` of ``(n ≥ 1,)`` values: NumPy's, a NaN anywhere is the maximum."""
+    top = x[0]
+    for v in x:
+        if v != v:
+            return v
+        top = max(top, v)
+    return top
 
 
 @njit(cache=True, inline="always")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numba import njit
@@ -52,6 +53,21 @@ class Footprint:
         """``(k, 2)`` polygon at ``pose``, or ``None`` for a circle."""
         return None if self.polygon is None else transform_points(self.polygon, pose)
 
+    @cached_property
+    def reach(self) -> float:
+        """Radius (m) of a circle about the robot origin that surely holds the footprint.
+
+        ``radius``, or for a polygon the larger of it and its farthest vertex, plus a margin
+        (:data:`_REACH_MARGIN`) far above the rounding of placing the polygon at a pose.
+        """
+        if self.polygon is None:
+            return self.radius
+        return max(self.radius, bounding_radius(self.polygon)) + _REACH_MARGIN
+
+
+_REACH_MARGIN = 1e-6
+"""m: placed vertices are within rounding (~1e-15 m) of their exact places."""
+
 
 def hits_grid(
     grid: OccupancyGrid,
@@ -89,18 +105,53 @@ def hits_grid(
     k = math.ceil(r / res) + 1
     r0, r1 = max(row - k, 0), min(row + k + 1, grid.height)
     c0, c1 = max(col - k, 0), min(col + k + 1, grid.width)
+    ox, oy = grid.origin
+    # A circle's exact test; for a polygon, a square that misses the circle holding it misses
+    # the polygon too, so the separating-axis tests run only when some square comes that near.
+    near = _squares_within(grid.occupied, r0, r1, c0, c1, ox, oy, res, x, y, fp.reach)
+    if fp.polygon is None or not near:
+        return near
     rows, cols = np.nonzero(grid.occupied[r0:r1, c0:c1])
-    if rows.size == 0:
-        return False
-    cx = grid.origin[0] + (cols + c0 + 0.5) * res
-    cy = grid.origin[1] + (rows + r0 + 0.5) * res
+    cx = ox + (cols + c0 + 0.5) * res
+    cy = oy + (rows + r0 + 0.5) * res
     half = 0.5 * res
-    if fp.polygon is None:
-        dx = np.maximum(np.abs(cx - x) - half, 0.0)
-        dy = np.maximum(np.abs(cy - y) - half, 0.0)
-        return bool(np.any(dx * dx + dy * dy < r * r))
     poly = transform_points(fp.polygon, pose)
     return bool(np.any(convex_polygon_overlaps_squares(poly, np.stack([cx, cy], axis=1), half)))
+
+
+@njit(cache=True)
+def _squares_within(
+    occupied: NDArray[np.bool_],
+    r0: int,
+    r1: int,
+    c0: int,
+    c1: int,
+    ox: float,
+    oy: float,
+    res: float,
+    x: float,
+    y: float,
+    radius: float,
+) -> bool:
+    """Whether a blocking cell of rows ``r0:r1``, columns ``c0:c1`` overlaps a circle.
+
+    The cell squares (edge ``res`` m, grid origin ``(ox, oy)`` m) against the open disc of
+    ``radius`` (m) about ``(x, y)`` (m): the clamped-gap test ``dx² + dy² < radius²`` with
+    :func:`hits_grid`'s former NumPy expressions, element by element (the same bits).
+    """
+    half = 0.5 * res
+    r2 = radius * radius
+    for row in range(r0, r1):
+        cy = oy + (row + 0.5) * res
+        dy = max(abs(cy - y) - half, 0.0)
+        for col in range(c0, c1):
+            if not occupied[row, col]:
+                continue
+            cx = ox + (col + 0.5) * res
+            dx = max(abs(cx - x) - half, 0.0)
+            if dx * dx + dy * dy < r2:
+                return True
+    return False
 
 
 @dataclass(frozen=True, eq=False)
@@ -169,8 +220,9 @@ def first_agent_hit(
     """Index of the nearest pedestrian circle the footprint overlaps, or -1."""
     if positions.shape[0] == 0:
         return -1
-    poly = _EMPTY_POLY if fp.polygon is None else _place(fp.polygon, pose)
-    return int(_agent_hit_kernel(float(pose[0]), float(pose[1]), fp.radius, poly, positions, radii))
+    body = _EMPTY_POLY if fp.polygon is None else fp.polygon
+    pose = np.asarray(pose, dtype=np.float64)
+    return int(_agent_hit_kernel(pose, float(fp.radius), body, positions, radii))
 
 
 @njit(cache=True)
@@ -189,18 +241,23 @@ _EMPTY_POLY = np.zeros((0, 2))
 
 @njit(cache=True)
 def _agent_hit_kernel(
-    x: float,
-    y: float,
+    pose: NDArray[np.float64],
     radius: float,
-    poly: NDArray[np.float64],
+    body: NDArray[np.float64],
     positions: NDArray[np.float64],
     radii: NDArray[np.float64],
 ) -> int:
-    """Nearest circle overlapping a circle (``poly`` empty) or a convex polygon, else -1.
+    """Nearest circle overlapping a circle (``body`` empty) or a convex polygon, else -1.
+
+    ``pose`` ``(3,)`` ``(x, y, θ)`` (m, rad); ``radius`` the footprint's bounding radius (m);
+    ``body`` ``(k, 2)`` the polygon in the robot frame, placed here (:func:`_place`, one call
+    per robot and step); ``positions`` ``(n, 2)`` m and ``radii`` ``(n,)`` m the circles.
 
     A circle overlaps a convex polygon when its centre is inside, or when it comes within its
     radius of an edge (touching counts, as in :func:`circles_overlap_polygon`).
     """
+    x, y = pose[0], pose[1]
+    poly = _place(body, pose)
     best, best_d = -1, np.inf
     k = poly.shape[0]
     for i in range(positions.shape[0]):
