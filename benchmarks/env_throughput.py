@@ -1,6 +1,6 @@
 """RL environment throughput: env steps/s for one SocialNavEnv and the batched vector env.
 
-    python benchmarks/env_throughput.py [--steps 2000] [--worlds 16 64] [--threads 2]
+    python benchmarks/env_throughput.py [--steps 10000] [--worlds 16 64] [--threads 2]
 
 The issue-7 setup: a jackal (720 beams, 30 m) among 20 pedestrians on the packaged
 ``small_office`` world with 4 static obstacles; default observation (lidar + goal + last
@@ -76,7 +76,8 @@ def batched(n: int, steps: int) -> float:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--steps", type=int, default=2000, help="env steps per measurement")
+    ap.add_argument("--steps", type=int, default=10_000,
+                    help="env steps per measurement (resets included: ~40 episodes single)")
     ap.add_argument("--worlds", type=int, nargs="+", default=[16, 64])
     ap.add_argument("--threads", type=int, default=2, help="numba threads (batched)")
     ap.add_argument("--skip-single", action="store_true")

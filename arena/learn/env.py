@@ -32,15 +32,16 @@ Crowd:
     social-force ``pysocial`` model with Arena's social states (idle, talking, phone, …), the
     people the benchmark evaluates against, so that a policy trains on the crowd it is tested
     on and an RL episode equals the ``arena run`` episode of the same seed and index. The
-    crowd is most of a step's cost. Measured on one shared core (small_office, jackal with 720
-    beams, 20 people, 2026-11, CPU time per env step, resets excluded): pysocial + social
-    states ≈ 1,300 steps/s (≈ 1,100 before the statechart kernels); pysocial without states
-    ≈ 1,550; pedsim or orca + states ≈ 1,300; ``waypoint_walker`` without states ≈ 2,700. For
-    throughput-bound experiments pass e.g.
+    crowd is the largest part of a step's cost. Measured on one core (small_office, jackal
+    with 720 beams, 20 people, 2026-11-21, CPU time per env step, resets excluded):
+    pysocial + social states ≈ 3,500 steps/s (≈ 1,100 before the crowd, statechart and env
+    kernels of 2026-11-21); pysocial without states ≈ 3,800; pedsim or orca + states
+    ≈ 3,400–3,600; ``waypoint_walker`` without states ≈ 5,900. For throughput-bound
+    experiments pass e.g.
     ``overrides=["crowd={type: waypoint_walker}", "pedestrians.social_states=false"]``
     (scripted walkers: no reaction to the robot), or train on
-    :class:`~arena.learn.batched.BatchedSocialNavEnv`. An episode reset (task generation,
-    mostly the distance transforms) costs ≈ 30 ms.
+    :class:`~arena.learn.batched.BatchedSocialNavEnv`. An episode reset (task generation, crowd
+    and simulator setup) costs ≈ 8–10 ms of CPU.
 
 Starting State:
     The episode's start pose, at rest; people at their spawn positions.
