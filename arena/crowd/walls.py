@@ -82,18 +82,34 @@ class WallIndex:
     def __init__(self, a: FloatArray, b: FloatArray, piece: float = 1.0) -> None:
         a = np.asarray(a, dtype=np.float64).reshape(-1, 2)
         b = np.asarray(b, dtype=np.float64).reshape(-1, 2)
-        lengths = np.hypot(*(b - a).T) if len(a) else np.zeros(0)
-        counts = np.maximum(np.ceil(lengths / piece).astype(np.int64), 1)
-        owner = np.repeat(np.arange(len(a), dtype=np.int64), counts)
-        k = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
-        t0 = k / np.repeat(counts, counts)
-        t1 = (k + 1) / np.repeat(counts, counts)
-        d = (b - a)[owner]
-        self.a = a[owner] + t0[:, None] * d
-        self.b = a[owner] + t1[:, None] * d
-        self.owner = owner
+        self.a, self.b, self.owner = _pieces(a, b, piece)
+        self._segments = int(a.shape[0])
+        self._piece = piece
+        self._index()
+
+    def extended(self, a: FloatArray, b: FloatArray) -> WallIndex:
+        """The index of this one's segments followed by ``(s, 2)`` segments ``a`` → ``b``.
+
+        ``WallIndex(concat([own a, a]), concat([own b, b]), piece)`` to the bit, without
+        splitting this one's segments again: pieces are cut segment by segment. A reset adds
+        the episode's obstacle edges to the map's walls (the same on every episode of a map).
+        """
+        a = np.asarray(a, dtype=np.float64).reshape(-1, 2)
+        b = np.asarray(b, dtype=np.float64).reshape(-1, 2)
+        pa, pb, owner = _pieces(a, b, self._piece)
+        out = WallIndex.__new__(WallIndex)
+        out.a = np.concatenate([self.a, pa])
+        out.b = np.concatenate([self.b, pb])
+        out.owner = np.concatenate([self.owner, owner + self._segments])
+        out._segments = self._segments + int(a.shape[0])
+        out._piece = self._piece
+        out._index()
+        return out
+
+    def _index(self) -> None:
+        """The longest half-piece and the cell list over the pieces' midpoints."""
         self.half = 0.5 * float(np.max(np.hypot(*(self.b - self.a).T))) if len(self.a) else 0.0
-        self._cells = CellList(0.5 * (self.a + self.b), max(piece, 1e-3))
+        self._cells = CellList(0.5 * (self.a + self.b), max(self._piece, 1e-3))
 
     def __len__(self) -> int:
         return int(self.a.shape[0])
@@ -121,6 +137,25 @@ class WallIndex:
         pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 2)
         cand = self._cells.query(pts, max_dist + self.half)
         return _nearest(pts, self.a, self.b, cand.indptr, cand.indices, float(max_dist))
+
+
+def _pieces(
+    a: FloatArray, b: FloatArray, piece: float
+) -> tuple[FloatArray, FloatArray, NDArray[np.int64]]:
+    """Segments ``(s, 2)`` ``a`` → ``b`` cut into equal pieces of at most ``piece`` m.
+
+    Returns:
+        ``(pa, pb, owner)``: ``(m, 2)`` piece ends and ``(m,)`` the segment of each piece
+        (every segment gives at least one piece, in order).
+    """
+    lengths = np.hypot(*(b - a).T) if len(a) else np.zeros(0)
+    counts = np.maximum(np.ceil(lengths / piece).astype(np.int64), 1)
+    owner = np.repeat(np.arange(len(a), dtype=np.int64), counts)
+    k = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+    t0 = k / np.repeat(counts, counts)
+    t1 = (k + 1) / np.repeat(counts, counts)
+    d = (b - a)[owner]
+    return a[owner] + t0[:, None] * d, a[owner] + t1[:, None] * d, owner
 
 
 @njit(cache=True, inline="always")

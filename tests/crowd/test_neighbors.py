@@ -116,6 +116,26 @@ def test_compiled_cell_list_is_the_constructors(n: int, scale: float, cell: floa
     np.testing.assert_array_equal(got.starts, want.starts)
 
 
+@pytest.mark.parametrize(
+    ("n", "scale", "cell"), [(1, 1.0, 1.0), (50, 1e-3, 0.01), (3000, 30.0, 5.0)]
+)
+def test_cell_list_is_the_numpy_construction(n: int, scale: float, cell: float) -> None:
+    """Bounds by numpy's min/max, cells ordered by a stable argsort of their ids."""
+    pts = np.random.default_rng(n).normal(0.0, scale, (n, 2))
+    pts[n // 2 :] = pts[: n - n // 2]  # repeated points: ties in the sort
+    got = CellList(pts, cell)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    nx = math.floor((hi[0] - lo[0]) / cell) + 1
+    ny = math.floor((hi[1] - lo[1]) / cell) + 1
+    assert got.origin.tobytes() == lo.tobytes() and got.shape == (nx, ny) and got.cell == cell
+    cx = np.clip(((pts[:, 0] - lo[0]) / cell).astype(np.int64), 0, nx - 1)
+    cy = np.clip(((pts[:, 1] - lo[1]) / cell).astype(np.int64), 0, ny - 1)
+    cid = cy * nx + cx
+    np.testing.assert_array_equal(got.order, np.argsort(cid, kind="stable"))
+    counts = np.bincount(cid, minlength=nx * ny)
+    np.testing.assert_array_equal(got.starts, np.r_[0, np.cumsum(counts)])
+
+
 def test_compiled_cell_list_leaves_odd_extents_to_the_constructor() -> None:
     huge = CellList._of_copy(np.array([[0.0, 0.0], [1e300, 1.0]]), 1.0)  # coarsened, not overflown
     want = CellList(np.array([[0.0, 0.0], [1e300, 1.0]]), 1.0)

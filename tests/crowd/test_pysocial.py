@@ -626,3 +626,30 @@ def test_nan_max_kernel_is_numpys_max() -> None:
     cases += [np.array([0.3, np.nan, 0.5]), np.array([np.nan]), np.array([0.2, 0.2, np.inf])]
     for x in cases:
         assert np.array_equal(_nan_max(x), x.max(), equal_nan=True)
+
+
+def test_reset_points_are_the_episode_segments_sampled() -> None:
+    """Map walls sampled once per map plus this episode's obstacle edges == sampling them all."""
+    from arena.crowd.simulator import episode_segments
+
+    occ = np.zeros((60, 80), dtype=bool)
+    occ[20:40, 30:33] = True
+    grid = OccupancyGrid.from_occupied(occ, 0.1)
+    other = OccupancyGrid.from_occupied(np.roll(occ, 7, axis=1), 0.1)
+    box = np.array([[-0.4, -0.3], [0.4, -0.3], [0.4, 0.3], [-0.4, 0.3]])
+    state = CrowdState.from_spawn(AgentSpawn.empty())
+    model = PySocialModel()
+    for g, obstacles in [
+        (grid, ()),
+        (grid, (Obstacle("a", "cuboid", np.array([2.0, 2.0, 0.4]), box),)),
+        (grid, (Obstacle("b", "cuboid", np.array([6.0, 4.0, -1.0]), box),)),
+        (other, (Obstacle("b", "cuboid", np.array([6.0, 4.0, -1.0]), box),)),
+    ]:
+        world = StaticWorld.build(g, obstacles)
+        model.reset(state, world, np.random.default_rng(0))
+        want = sample_segments(*episode_segments(world), model.params.resolution)
+        assert model.obstacle_points.tobytes() == want.tobytes()
+        ref = PySocialModel()
+        ref.set_obstacles(*episode_segments(world))
+        np.testing.assert_array_equal(model._cells.order, ref._cells.order)
+        np.testing.assert_array_equal(model._obstacles.xy, ref._obstacles.xy)

@@ -7,7 +7,7 @@ from arena.crowd.simulator import CrowdSimulator, PedestrianConfig, form_groups,
 from arena.crowd.state import SocialState, StartupMode
 from arena.crowd.walls import WallIndex, grid_wall_segments
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import RobotStates, StaticWorld
+from arena.sim.state import Obstacle, RobotStates, StaticWorld
 from arena.tasks.episode import WAYPOINT_LOOP, WAYPOINT_RANDOM, AgentSpawn
 
 WORLD = StaticWorld.build(OccupancyGrid.empty(20, 20, 0.1))
@@ -319,3 +319,99 @@ def test_integrate_factors_are_the_premultiplied_arrays():
     got = integrate(*args, vmax, radii, 0.2, vmax_factor=factor, clearance_scale=0.8)
     want = integrate(*args, vmax * factor, 0.8 * radii, 0.2)
     assert got[0].tobytes() == want[0].tobytes() and got[1].tobytes() == want[1].tobytes()
+
+
+# -- per-map caches of the reset (each against the computation it replaces, to the bit) ---------
+def _random_polygons(rng, grid, k):
+    """``k`` convex polygons anywhere on (and partly off) ``grid``, some tiny, some large."""
+    lo = np.array(grid.origin)
+    hi = lo + np.array([grid.width, grid.height]) * grid.resolution
+    polys = []
+    for _ in range(k):
+        c = rng.uniform(lo - 0.5, hi + 0.5)
+        ang = np.sort(rng.uniform(0.0, 2.0 * np.pi, int(rng.integers(3, 7))))
+        r = rng.uniform(0.02, 0.3 * float(np.min(hi - lo)))
+        polys.append(c + r * np.stack([np.cos(ang), np.sin(ang)], axis=1))
+    return polys
+
+
+def test_crowd_clearance_is_the_full_distance_transform():
+    """The map's cached clearance lowered near each obstacle == the transform of the union."""
+    from arena.crowd.simulator import crowd_clearance
+    from arena.maps.raster import polygon_mask
+    from arena.tasks.sampling import clearance_map
+
+    rng = np.random.default_rng(3)
+    for trial in range(12):
+        h, w = int(rng.integers(20, 90)), int(rng.integers(20, 90))
+        occ = rng.random((h, w)) < (0.0 if trial == 0 else 0.02)  # one map with no walls at all
+        occ[int(rng.integers(h)), :] = trial % 2 == 1  # a wall across, on some maps
+        grid = OccupancyGrid.from_occupied(occ, 0.05 + 0.05 * (trial % 3), origin=(-1.0, 2.0))
+        for k in (0, 1, 3, 6):
+            polys = _random_polygons(rng, grid, k)
+            blocked = grid.occupied | polygon_mask(grid, polys) if polys else grid.occupied
+            want = clearance_map(grid, blocked)
+            got = crowd_clearance(grid, polys)
+            assert got.tobytes() == want.tobytes()
+            assert got.flags.writeable
+            got[:] = -1.0  # a new array per episode: writing to it leaves the cache intact
+            assert crowd_clearance(grid, polys).tobytes() == want.tobytes()
+
+
+def test_crowd_clearance_cache_follows_the_map():
+    """Another grid (other occupancy, same shape) is computed afresh, not served the old map."""
+    from arena.crowd.simulator import crowd_clearance
+    from arena.tasks.sampling import clearance_map
+
+    occ = np.zeros((40, 50), dtype=bool)
+    first = OccupancyGrid.from_occupied(occ, 0.1)
+    assert crowd_clearance(first, []).tobytes() == clearance_map(first).tobytes()
+    occ[10:30, 20:23] = True
+    second = OccupancyGrid.from_occupied(occ, 0.1)
+    got = crowd_clearance(second, [])
+    assert got.tobytes() == clearance_map(second).tobytes()
+    assert got.tobytes() != crowd_clearance(first, []).tobytes()
+
+
+def test_simulator_reset_uses_this_episodes_obstacles():
+    """Two episodes on one map with different obstacles: each gets its own clearance map."""
+    from arena.maps.raster import polygon_mask
+    from arena.tasks.sampling import clearance_map
+
+    grid = OccupancyGrid.empty(20, 20, 0.1)
+    sim = CrowdSimulator(WaypointWalker(), PLAIN)
+    for x in (5.0, 12.0):
+        box = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+        ob = Obstacle("box", "cuboid", np.array([x, 10.0, 0.3]), box)
+        world = StaticWorld.build(grid, (ob,))
+        sim.reset(spawn(), world, np.random.default_rng(0))
+        want = clearance_map(grid, grid.occupied | polygon_mask(grid, [ob.polygon]))
+        assert sim._clearance.tobytes() == want.tobytes()
+
+
+def test_extended_wall_index_is_the_index_of_all_segments():
+    """Map walls indexed once, obstacle edges appended == indexing every segment at once."""
+    from arena.crowd.simulator import episode_segments
+
+    rng = np.random.default_rng(4)
+    occ = rng.random((40, 60)) < 0.03
+    grid = OccupancyGrid.from_occupied(occ, 0.1)
+    sim = CrowdSimulator(WaypointWalker(), PLAIN)
+    walls = WallIndex(*grid_wall_segments(grid))
+    for k in (0, 1, 3):
+        box = np.array([[-0.6, -0.2], [0.6, -0.2], [0.6, 0.2], [-0.6, 0.2]])
+        obs = tuple(
+            Obstacle(f"o{i}", "cuboid", np.r_[rng.uniform(1, 5, 2), rng.uniform(-3, 3)], box)
+            for i in range(k)
+        )
+        world = StaticWorld.build(grid, obs)
+        sim.reset(spawn(), world, np.random.default_rng(0))
+        want = WallIndex(*episode_segments(world))
+        for got in (walls.extended(world.segments_a, world.segments_b), sim._wall_index):
+            for name in ("a", "b", "owner"):
+                assert getattr(got, name).tobytes() == getattr(want, name).tobytes()
+            assert got.half == want.half and len(got) == len(want)
+            gc, wc = got._cells, want._cells
+            assert gc.origin.tobytes() == wc.origin.tobytes() and gc.shape == wc.shape
+            np.testing.assert_array_equal(gc.order, wc.order)
+            np.testing.assert_array_equal(gc.starts, wc.starts)

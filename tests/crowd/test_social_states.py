@@ -137,6 +137,54 @@ def test_truncated_normal_keeps_bounds_and_moments():
     assert (Dist(mean=3.0, lo=0.0, hi=1.0).sample(5, rng) == 1.0).all()
 
 
+def _agent_params_one_by_one(params, is_elder, rng):
+    """The reference: one ``truncated_normal`` per parameter, in declaration order."""
+    from arena.crowd.social.params import truncated_normal
+
+    out = {}
+    for name in HumanParams.dist_names():
+        d = getattr(params.human, name)
+        u = rng.random(len(is_elder))
+        mean = np.full(len(is_elder), d.mean)
+        k = params.elder.offsets.get(name, 0.0)
+        if k:
+            mean[is_elder] += k * d.sigma
+        vals = truncated_normal(mean, d.sigma, d.lo, d.hi, u)
+        if name in params.elder.constants:
+            vals[is_elder] = params.elder.constants[name]
+        out[name] = vals
+    return out
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, 40])
+def test_agent_params_drawn_together_are_the_one_by_one_draws(n):
+    """All parameters at once: the same bits and the same generator state afterwards."""
+    from arena.crowd.social import ElderOffsets
+
+    custom = SocialStatesParams(
+        human=HumanParams(
+            stress_lo=Dist(mean=0.3, sigma=0.0, lo=0.4),  # sigma 0: the clipped mean
+            fear_robot=Dist(mean=0.0, sigma=1.0, lo=8.0, hi=9.0),  # the upper tail (mirrored)
+            vision_angle=Dist(mean=-0.0, sigma=0.0),
+        ),
+        elder=ElderOffsets(
+            offsets={"vision_range": -3.0, "stress_lo": 1.5},
+            constants={"energy_hi": 1.0, "social_lo": 0.2},
+        ),
+    )
+    for params in (SocialStatesParams(), custom):
+        for frac in (0.0, 0.4, 1.0):
+            elder = np.random.default_rng(n).random(n) < frac
+            r1, r2 = np.random.default_rng(5), np.random.default_rng(5)
+            got = sample_agent_params(params, elder, r1)
+            want = _agent_params_one_by_one(params, elder, r2)
+            assert list(got) == list(want)
+            for name in want:
+                assert got[name].shape == (n,)
+                assert got[name].tobytes() == want[name].tobytes(), name
+            assert r1.random() == r2.random()
+
+
 def test_elders_shift_means_by_sigma_and_never_want_to_run():
     rng = np.random.default_rng(1)
     n = 40_000

@@ -256,3 +256,20 @@ def test_lidar_sees_two_legs(room):
     assert hits.sum() >= 2  # both legs are seen
     # Contacts still use the body circle.
     assert not s.collisions.any[0]
+
+
+def test_footprints_are_reused_across_resets(room):
+    """The same robot model keeps its prepared footprint; another model gets its own."""
+    jackal, burger = load_robot("jackal"), load_robot("burger")
+    b = Native2DBackend()
+    b.reset(make_episode(room, [(jackal, (2, 5, 0), (8, 5, 0))]), None, np.random.default_rng(0))
+    first = b._footprints[0]
+    want = Footprint.make(jackal.footprint_polygon(), jackal.circumscribed_radius)
+    assert first.polygon.tobytes() == want.polygon.tobytes() and first.radius == want.radius
+    b.reset(make_episode(room, [(jackal, (3, 5, 0), (8, 5, 0))]), None, np.random.default_rng(1))
+    assert b._footprints[0] is first
+    b.reset(make_episode(room, [(burger, (3, 5, 0), (8, 5, 0))]), None, np.random.default_rng(1))
+    other = Footprint.make(burger.footprint_polygon(), burger.circumscribed_radius)
+    got = b._footprints[0]
+    assert got is not first and got.radius == other.radius
+    assert (got.polygon is None) == (other.polygon is None)

@@ -275,13 +275,26 @@ class PySocialModel:
 
     def reset(self, state: CrowdState, world: StaticWorld, rng: np.random.Generator) -> None:
         """Sample the episode's walls and obstacle edges into points, once."""
-        # the map's walls are traced once per map, not per episode (see grid_walls)
-        from arena.crowd.simulator import episode_segments
+        from arena.crowd.simulator import grid_walls
+        from arena.tasks.sampling import grid_memo
 
-        a, b = episode_segments(world)
+        res = self.params.resolution
+
+        def wall_points() -> FloatArray:
+            pts = sample_segments(*grid_walls(world.grid), res)
+            pts.setflags(write=False)
+            return pts
+
+        # set_obstacles(*episode_segments(world)): segments are sampled one by one, so the
+        # map's walls (the same every episode on a map) are sampled once per map and the
+        # episode's obstacle edges appended.
+        walls = grid_memo(world.grid, ("pysocial wall points", float(res)), wall_points)
         r = self.params.agent_radius
         r_max = float(r) if r is not None else float(np.max(state.radii, initial=0.0))
-        self.set_obstacles(a, b, max_radius=r_max)
+        self._use_points(
+            np.concatenate([walls, sample_segments(world.segments_a, world.segments_b, res)]),
+            r_max,
+        )
 
     def set_obstacles(self, a: FloatArray, b: FloatArray, *, max_radius: float = 0.35) -> None:
         """Use these segments as the obstacles (what :meth:`reset` does with the world's).
@@ -291,7 +304,11 @@ class PySocialModel:
             b: ``(s, 2)`` segment ends (m).
             max_radius: largest agent radius to expect (m); sizes the point index.
         """
-        self.obstacle_points = sample_segments(a, b, self.params.resolution)
+        self._use_points(sample_segments(a, b, self.params.resolution), max_radius)
+
+    def _use_points(self, points: FloatArray, max_radius: float) -> None:
+        """Index ``(m, 2)`` obstacle points (m) (see :meth:`set_obstacles`)."""
+        self.obstacle_points = points
         p = self.params
         r = p.agent_radius if p.agent_radius is not None else max_radius
         self._cells = CellList(self.obstacle_points, p.obstacle_threshold + 2.0 * r)

@@ -12,6 +12,7 @@ Defaults are Arena's values (arena_specs §5.2); units are SI unless a field say
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Self
 
@@ -342,16 +343,68 @@ def sample_agent_params(
     n = int(is_elder.shape[0])
     human = params.human
     elder = params.elder
+    names = _dist_names()
+    dists: list[Dist] = [getattr(human, name) for name in names]
+    # One rng.random(n) per parameter, in declaration order (the stream of one call each);
+    # then the arithmetic of truncated_normal on all of them at once, row by row the same
+    # element-wise operations, so the same bits.
+    u = np.empty((len(names), n))
+    for i in range(len(names)):
+        u[i] = rng.random(n)
+    mean = np.empty((len(names), n))
+    mean[:] = np.array([d.mean for d in dists])[:, None]
+    elders = np.flatnonzero(is_elder)
+    if elders.size:
+        for i, (name, d) in enumerate(zip(names, dists, strict=True)):
+            k = elder.offsets.get(name, 0.0)
+            if k:
+                mean[i, elders] += k * d.sigma
+    sigma = np.array([d.sigma for d in dists])
+    lo = np.array([-math.inf if d.lo is None else float(d.lo) for d in dists])
+    hi = np.array([math.inf if d.hi is None else float(d.hi) for d in dists])
+    vals = np.clip(mean, lo[:, None], hi[:, None])  # sigma 0: the mean clipped to the bounds
+    rows = np.flatnonzero(sigma > 0.0)
+    if rows.size:
+        vals[rows] = _truncated_normal_rows(
+            mean[rows], sigma[rows, None], lo[rows, None], hi[rows, None], u[rows]
+        )
     out: dict[str, FloatArray] = {}
-    for name in HumanParams.dist_names():
-        d: Dist = getattr(human, name)
-        u = rng.random(n)
-        mean = np.full(n, d.mean)
-        k = elder.offsets.get(name, 0.0)
-        if k:
-            mean[is_elder] += k * d.sigma
-        vals = truncated_normal(mean, d.sigma, d.lo, d.hi, u)
+    for i, name in enumerate(names):
         if name in elder.constants:
-            vals[is_elder] = elder.constants[name]
-        out[name] = vals
+            vals[i, is_elder] = elder.constants[name]
+        out[name] = vals[i]
     return out
+
+
+def _truncated_normal_rows(
+    mean: FloatArray, sigma: FloatArray, lo: FloatArray, hi: FloatArray, u: FloatArray
+) -> FloatArray:
+    """:func:`truncated_normal` of each row, the same element-wise operations.
+
+    Args:
+        mean: ``(p, n)`` means.
+        sigma: ``(p, 1)`` standard deviations (> 0).
+        lo: ``(p, 1)`` lower bounds (-inf for none).
+        hi: ``(p, 1)`` upper bounds (inf for none).
+        u: ``(p, n)`` uniforms in ``[0, 1)``.
+
+    Returns:
+        ``(p, n)`` samples.
+    """
+    a = (lo - mean) / sigma
+    b = (hi - mean) / sigma
+    flip = a > 0.0
+    a2 = np.where(flip, -b, a)
+    b2 = np.where(flip, -a, b)
+    fa = ndtr(a2)
+    fb = ndtr(b2)
+    z = ndtri(fa + u * (fb - fa))
+    z = np.where(flip, -z, z)
+    out: FloatArray = np.clip(mean + sigma * z, lo, hi)
+    return out
+
+
+@functools.cache
+def _dist_names() -> tuple[str, ...]:
+    """:meth:`HumanParams.dist_names` (fixed by the class)."""
+    return HumanParams.dist_names()

@@ -64,6 +64,8 @@ class Native2DBackend:
         self._world: StaticWorld | None = None
         self._state: SimState | None = None
         self._lidars: dict[int, Lidar2D] = {}  # reused across episodes, keyed by spec identity
+        # Footprints by polygon and radius: the hull of the same robot is the same every episode.
+        self._footprint_cache: dict[tuple[object, ...], Footprint] = {}
 
     # -- protocol ------------------------------------------------------------------------------
     @property
@@ -102,9 +104,10 @@ class Native2DBackend:
         # Models whose whole step is the box pipeline are stepped in place by one compiled call
         # (box_step_row), without the per-robot state objects and input checks of Kinematics.step.
         self._boxes = [getattr(k, "box_limits", None) for k in self._kinematics]
+        polys = [r.model.footprint_polygon() for r in robots]  # new arrays, one per robot
         self._footprints = [
-            Footprint.make(r.model.footprint_polygon(), r.model.circumscribed_radius)
-            for r in robots
+            self._footprint(p, r.model.circumscribed_radius)
+            for p, r in zip(polys, robots, strict=True)
         ]
         self._specs = [r.model.laser for r in robots]
         self._scan_period = [1.0 / s.update_rate for s in self._specs]
@@ -122,7 +125,7 @@ class Native2DBackend:
         self._steering = np.zeros(n)
         self._commands = np.zeros((n, 3))
         self._radii = np.array([fp.radius for fp in self._footprints])
-        self._fp_polys = tuple(r.model.footprint_polygon() for r in robots)
+        self._fp_polys = tuple(polys)
         self._time = 0.0
         self._step = 0
         self._driver = pedestrians
@@ -141,6 +144,24 @@ class Native2DBackend:
         self._take_scans()
         self._state = self._snapshot(collisions)
         return self._state
+
+    def _footprint(self, polygon: NDArray[np.float64] | None, radius: float) -> Footprint:
+        """``Footprint.make(polygon, radius)``, the same object while the inputs are equal.
+
+        ``polygon``: ``(k, 2)`` m in the robot frame, or ``None`` for a circle of ``radius`` m.
+        """
+        if polygon is None:
+            key: tuple[object, ...] = (None, float(radius))
+        else:
+            p = np.asarray(polygon, dtype=np.float64)
+            key = (p.shape, p.tobytes(), float(radius))
+        fp = self._footprint_cache.get(key)
+        if fp is None:
+            if len(self._footprint_cache) >= 64:  # many robot models: keep it small
+                self._footprint_cache.clear()
+            fp = Footprint.make(polygon, radius)
+            self._footprint_cache[key] = fp
+        return fp
 
     def step(self, commands: NDArray[np.float64], dt: float) -> SimState:
         """Advance the world by ``dt`` seconds with ``(r, 3)`` body-twist commands."""
