@@ -32,7 +32,7 @@ from arena.maps.grid import OccupancyGrid
 from arena.maps.raster import polygon_window
 from arena.sim.state import AgentStates, RobotStates, StaticWorld
 from arena.tasks.episode import WAYPOINT_RANDOM, AgentSpawn
-from arena.tasks.sampling import clearance_map, grid_memo, squared_edt
+from arena.tasks.sampling import clearance_map, grid_memo, lower_envelope, squared_edt
 
 FloatArray = NDArray[np.float64]
 
@@ -427,32 +427,7 @@ def _lower_clearance(
     z = np.empty(nw + 1, dtype=np.float64)
     for r in range(h):
         f = g[r]
-        k = -1
-        for q in range(nw):
-            if f[q] == np.inf:
-                continue
-            if k < 0:
-                k = 0
-                v[0] = q
-                z[0] = -np.inf
-                z[1] = np.inf
-                continue
-            while True:
-                p = v[k]
-                s = ((f[q] + q * q) - (f[p] + p * p)) / (2.0 * q - 2.0 * p)
-                if s <= z[k] and k > 0:
-                    k -= 1
-                else:
-                    break
-            if s <= z[k]:
-                v[0] = q
-                z[1] = np.inf
-                continue
-            k += 1
-            v[k] = q
-            z[k] = s
-            z[k + 1] = np.inf
-        if k < 0:
+        if lower_envelope(f, v, z) < 0:
             continue
         k = 0
         row = out[br0 + r]

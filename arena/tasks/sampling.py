@@ -72,26 +72,7 @@ def _squared_edt(blocked: NDArray[np.bool_]) -> NDArray[np.float64]:
     z = np.empty(w + 1, dtype=np.float64)
     for r in range(h):
         f = g[r]
-        k = 0
-        v[0] = 0
-        z[0] = -np.inf
-        z[1] = np.inf
-        for q in range(1, w):
-            while True:
-                p = v[k]
-                s = ((f[q] + q * q) - (f[p] + p * p)) / (2.0 * q - 2.0 * p)
-                if s <= z[k] and k > 0:
-                    k -= 1
-                else:
-                    break
-            if s <= z[k]:  # k == 0 and q dominates the first parabola everywhere
-                v[0] = q
-                z[1] = np.inf
-                continue
-            k += 1
-            v[k] = q
-            z[k] = s
-            z[k + 1] = np.inf
+        lower_envelope(f, v, z)  # every f[q] is finite: the border is blocked
         k = 0
         for c in range(w):
             while z[k + 1] < c:
@@ -106,6 +87,43 @@ def _squared_edt(blocked: NDArray[np.bool_]) -> NDArray[np.float64]:
                 best = right
             out[r, c] = best
     return out
+
+
+@njit(cache=True)
+def lower_envelope(f: NDArray[np.float64], v: NDArray[np.int64], z: NDArray[np.float64]) -> int:
+    """Lower envelope of the parabolas ``x ↦ f[q] + (x − q)²`` over the finite ``f[q]``.
+
+    Felzenszwalb–Huttenlocher's second pass. Fills ``v`` (the apexes ``q`` of the envelope's
+    parabolas, left to right) and ``z`` (``z[k]``..``z[k+1]``: where parabola ``v[k]`` is
+    lowest; ``z[0] = -inf``, the last one ends at ``inf``); returns the last index ``k``, or -1
+    if every ``f[q]`` is ``inf``. ``f`` ``(w,)`` holds exact integers (squared cells).
+    """
+    k = -1
+    for q in range(f.shape[0]):
+        if f[q] == np.inf:
+            continue
+        if k < 0:
+            k = 0
+            v[0] = q
+            z[0] = -np.inf
+            z[1] = np.inf
+            continue
+        while True:
+            p = v[k]
+            s = ((f[q] + q * q) - (f[p] + p * p)) / (2.0 * q - 2.0 * p)
+            if s <= z[k] and k > 0:
+                k -= 1
+            else:
+                break
+        if s <= z[k]:  # k == 0 and q dominates the first parabola everywhere
+            v[0] = q
+            z[1] = np.inf
+            continue
+        k += 1
+        v[k] = q
+        z[k] = s
+        z[k + 1] = np.inf
+    return k
 
 
 _STATIC = GridMemo(32)

@@ -76,19 +76,7 @@ def truncated_normal(
     hi_v = math.inf if hi is None else float(hi)
     if sigma <= 0.0:
         return np.clip(mean, lo_v, hi_v)
-    a = (lo_v - mean) / sigma
-    b = (hi_v - mean) / sigma
-    # Work in the mirrored variable when the interval lies in the upper tail: ndtr near 1 loses
-    # all precision, near 0 it does not.
-    flip = a > 0.0
-    a2 = np.where(flip, -b, a)
-    b2 = np.where(flip, -a, b)
-    fa = ndtr(a2)
-    fb = ndtr(b2)
-    z = ndtri(fa + u * (fb - fa))
-    z = np.where(flip, -z, z)
-    out: FloatArray = np.clip(mean + sigma * z, lo_v, hi_v)
-    return out
+    return _truncated_normal_rows(mean, sigma, lo_v, hi_v, u)
 
 
 def _nd(mean: float, sigma: float, lo: float | None = None, hi: float | None = None) -> Dist:
@@ -377,9 +365,10 @@ def sample_agent_params(
 
 
 def _truncated_normal_rows(
-    mean: FloatArray, sigma: FloatArray, lo: FloatArray, hi: FloatArray, u: FloatArray
+    mean: FloatArray, sigma: FloatArray | float, lo: FloatArray | float, hi: FloatArray | float,
+    u: FloatArray,
 ) -> FloatArray:
-    """:func:`truncated_normal` of each row, the same element-wise operations.
+    """The inverse-CDF draws of :func:`truncated_normal`, element-wise (shapes broadcast).
 
     Args:
         mean: ``(p, n)`` means.
@@ -393,6 +382,8 @@ def _truncated_normal_rows(
     """
     a = (lo - mean) / sigma
     b = (hi - mean) / sigma
+    # Work in the mirrored variable when the interval lies in the upper tail: ndtr near 1 loses
+    # all precision, near 0 it does not.
     flip = a > 0.0
     a2 = np.where(flip, -b, a)
     b2 = np.where(flip, -a, b)

@@ -168,22 +168,29 @@ def integrate_twist(poses: FloatArray, twists: FloatArray, dt: float) -> FloatAr
 @njit(cache=True)
 def _integrate_kernel(poses: FloatArray, twists: FloatArray, dt: float, out: FloatArray) -> None:
     for i in range(poses.shape[0]):
-        vx, vy, om = twists[i, 0], twists[i, 1], twists[i, 2]
-        phi = om * dt
-        if abs(phi) < 1e-4:
-            p2 = phi * phi
-            s = dt * (1.0 - p2 / 6.0 + p2 * p2 / 120.0)  # sin(phi)/omega
-            c = dt * phi * (0.5 - p2 / 24.0 + p2 * p2 / 720.0)  # (1 - cos phi)/omega
-        else:
-            s = math.sin(phi) / om
-            c = (1.0 - math.cos(phi)) / om
-        dxb = s * vx - c * vy
-        dyb = c * vx + s * vy
-        th = poses[i, 2]
-        ct, st = math.cos(th), math.sin(th)
-        out[i, 0] = poses[i, 0] + ct * dxb - st * dyb
-        out[i, 1] = poses[i, 1] + st * dxb + ct * dyb
-        out[i, 2] = (th + phi + math.pi) % (2.0 * math.pi) - math.pi
+        _integrate_row(poses, twists, dt, i, out)
+
+
+@njit(cache=True, inline="always")
+def _integrate_row(poses: FloatArray, twists: FloatArray, dt: float, i: int,
+                   out: FloatArray) -> None:
+    """Row ``i`` of :func:`_integrate_kernel`: exact arc under the constant twist ``twists[i]``."""
+    vx, vy, om = twists[i, 0], twists[i, 1], twists[i, 2]
+    phi = om * dt
+    if abs(phi) < 1e-4:
+        p2 = phi * phi
+        s = dt * (1.0 - p2 / 6.0 + p2 * p2 / 120.0)  # sin(phi)/omega
+        c = dt * phi * (0.5 - p2 / 24.0 + p2 * p2 / 720.0)  # (1 - cos phi)/omega
+    else:
+        s = math.sin(phi) / om
+        c = (1.0 - math.cos(phi)) / om
+    dxb = s * vx - c * vy
+    dyb = c * vx + s * vy
+    th = poses[i, 2]
+    ct, st = math.cos(th), math.sin(th)
+    out[i, 0] = poses[i, 0] + ct * dxb - st * dyb
+    out[i, 1] = poses[i, 1] + st * dxb + ct * dyb
+    out[i, 2] = (th + phi + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def box_step(
@@ -285,22 +292,7 @@ def _box_row_kernel(
         step = acc[k] * dt
         d = min(max(target - prev, -step), step)
         out_t[i, k] = min(max(prev + d, lo), hi)
-    vx, vy, om = out_t[i, 0], out_t[i, 1], out_t[i, 2]
-    phi = om * dt
-    if abs(phi) < 1e-4:
-        p2 = phi * phi
-        s = dt * (1.0 - p2 / 6.0 + p2 * p2 / 120.0)  # sin(phi)/omega
-        c = dt * phi * (0.5 - p2 / 24.0 + p2 * p2 / 720.0)  # (1 - cos phi)/omega
-    else:
-        s = math.sin(phi) / om
-        c = (1.0 - math.cos(phi)) / om
-    dxb = s * vx - c * vy
-    dyb = c * vx + s * vy
-    th = poses[i, 2]
-    ct, st = math.cos(th), math.sin(th)
-    out_p[i, 0] = poses[i, 0] + ct * dxb - st * dyb
-    out_p[i, 1] = poses[i, 1] + st * dxb + ct * dyb
-    out_p[i, 2] = (th + phi + math.pi) % (2.0 * math.pi) - math.pi
+    _integrate_row(poses, out_t, dt, i, out_p)
 
 
 def quadric_norm(v: FloatArray, weights: FloatArray) -> FloatArray:
