@@ -6,13 +6,13 @@ Arena compares the world-frame bearing ``|angle(p − p_i)|`` with the vision an
 "look" along +x whatever their heading; we measure the bearing relative to the heading instead.
 
 The queries come twice: vectorised over many agents (:func:`sees`, :func:`nearest_seen_agents`
-...), the reference, and compiled for one agent (:func:`sees_one`, :func:`nearest_seen_agent`
-...), which the statechart's kernels call. The compiled ones give the same answers bit for bit:
-they scan the same cell lists in the same order (so ties in distance go the same way as numpy's
-stable sort) and do the same arithmetic. One catch: numpy's ``arctan2`` is a SIMD routine that
-may differ from libm's ``atan2`` (which numba calls) in the last bit, so a bearing within
-``_CONE_MARGIN`` of the cone's edge, the only place where that bit can change the answer, is
-decided again with numpy's.
+and the others), the reference, and compiled for one agent (:func:`sees_one`,
+:func:`nearest_seen_agent` and the others), which the statechart's kernels call. The compiled
+ones give the same answers bit for bit: they scan the same cell lists in the same order (so ties
+in distance go the same way as numpy's stable sort) and do the same arithmetic. One catch:
+numpy's ``arctan2`` is a SIMD routine that may differ from libm's ``atan2`` (which numba calls)
+in the last bit, so a bearing within ``_CONE_MARGIN`` of the cone's edge, the only place where
+that bit can change the answer, is decided again with numpy's.
 """
 
 from __future__ import annotations
