@@ -121,6 +121,16 @@ def _as_lists(
     return bounds[0].tolist(), bounds[1].tolist()
 
 
+def _clipped(
+    values: FloatArray, bounds: tuple[FloatArray, FloatArray],
+    bounds_l: tuple[list[float], list[float]],
+) -> NDArray[np.float32]:
+    """``values`` ``(n, 3)`` clipped to ``bounds`` as float32 (one world: :func:`_clip_one`)."""
+    if values.shape[0] == 1:
+        return _clip_one(values, *bounds_l)
+    return values.clip(*bounds).astype(np.float32)
+
+
 def _clip_one(values: FloatArray, lo: list[float], hi: list[float]) -> NDArray[np.float32]:
     """``values.clip(lo, hi).astype(float32)`` of one row ``(1, d)``, the same bits.
 
@@ -245,19 +255,11 @@ class ObservationBuilder:
                 goal[:, 1] = theta
                 out["goal"] = goal
         if self._action_bounds is not None:
-            if n == 1:
-                lo_l, hi_l = self._action_bounds_l
-                out["last_action"] = _clip_one(inp.last_action, lo_l, hi_l)
-            else:
-                lo, hi = self._action_bounds
-                out["last_action"] = inp.last_action.clip(lo, hi).astype(np.float32)
+            out["last_action"] = _clipped(
+                inp.last_action, self._action_bounds, self._action_bounds_l
+            )
         if self._velocity_bounds is not None:
-            if n == 1:
-                lo_l, hi_l = self._velocity_bounds_l
-                out["velocity"] = _clip_one(inp.twists, lo_l, hi_l)
-            else:
-                lo, hi = self._velocity_bounds
-                out["velocity"] = inp.twists.clip(lo, hi).astype(np.float32)
+            out["velocity"] = _clipped(inp.twists, self._velocity_bounds, self._velocity_bounds_l)
         if self._people:
             rel = to_robot_frame(inp.ped_pos - inp.poses[:, None, :2], inp.poses[:, 2])
             if cfg.pedestrians.enabled:

@@ -231,13 +231,22 @@ def _box_kernel(
     out: FloatArray,
 ) -> None:
     for i in range(poses.shape[0]):
-        for k in range(3):
-            lo, hi = lower[k], upper[k]
-            target = min(max(cmd[i, k], lo), hi)
-            prev = min(max(twists[i, k], lo), hi)
-            step = acc[k] * dt
-            d = min(max(target - prev, -step), step)
-            out[i, k] = min(max(prev + d, lo), hi)
+        _box_twist_row(twists, cmd, lower, upper, acc, dt, i, out)
+
+
+@njit(cache=True, inline="always")
+def _box_twist_row(
+    twists: FloatArray, cmd: FloatArray, lower: FloatArray, upper: FloatArray, acc: FloatArray,
+    dt: float, i: int, out: FloatArray,
+) -> None:
+    """Row ``i`` of :func:`_box_kernel`: the command clipped to the box, steps up to ``acc·dt``."""
+    for k in range(3):
+        lo, hi = lower[k], upper[k]
+        target = min(max(cmd[i, k], lo), hi)
+        prev = min(max(twists[i, k], lo), hi)
+        step = acc[k] * dt
+        d = min(max(target - prev, -step), step)
+        out[i, k] = min(max(prev + d, lo), hi)
 
 
 def box_step_row(
@@ -285,13 +294,7 @@ def _box_row_kernel(
     out_t: FloatArray,
 ) -> None:
     # _box_kernel then _integrate_kernel for one row, the same operations in the same order
-    for k in range(3):
-        lo, hi = lower[k], upper[k]
-        target = min(max(cmd[i, k], lo), hi)
-        prev = min(max(twists[i, k], lo), hi)
-        step = acc[k] * dt
-        d = min(max(target - prev, -step), step)
-        out_t[i, k] = min(max(prev + d, lo), hi)
+    _box_twist_row(twists, cmd, lower, upper, acc, dt, i, out_t)
     _integrate_row(poses, out_t, dt, i, out_p)
 
 
