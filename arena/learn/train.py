@@ -375,6 +375,23 @@ class LinearSchedule:
         return self.final + (self.initial - self.final) * float(progress_remaining)
 
 
+def actor_parameters(policy: Any) -> list[Any]:
+    """The parameters that shape an SB3 ``ActorCriticPolicy``'s action distribution.
+
+    Its feature extractor (the actor's own one, or the shared one, which then stays frozen for
+    the critic too), the actor MLP, the action mean layer and the log-std. Critic warm-up
+    (``learning.ppo.critic_warmup``) freezes exactly these.
+    """
+    extractor = (policy.features_extractor if policy.share_features_extractor
+                 else policy.pi_features_extractor)
+    params = [*extractor.parameters(), *policy.mlp_extractor.policy_net.parameters(),
+              *policy.action_net.parameters()]
+    log_std = getattr(policy, "log_std", None)  # a Gaussian policy's; none for discrete actions
+    if log_std is not None:
+        params.append(log_std)
+    return params
+
+
 def _callbacks() -> dict[str, type]:
     """SB3 callback classes (defined lazily: SB3 is optional)."""
     from stable_baselines3.common.callbacks import BaseCallback
@@ -389,6 +406,23 @@ def _callbacks() -> dict[str, type]:
             # every step it counts (inside a rollout the last update would be missing)
             if self.num_timesteps - self.trainer.last_checkpoint >= self.trainer.every_ckpt:
                 self.trainer.checkpoint()
+
+        def _on_step(self) -> bool:
+            return True
+
+    class CriticWarmupCallback(BaseCallback):
+        """Freeze the actor for the updates of rollouts ending by step ``until``."""
+
+        def __init__(self, until: int) -> None:
+            super().__init__()
+            self.until = until
+
+        def _on_rollout_end(self) -> None:
+            # called after collecting, before the update that learns from this rollout
+            frozen = self.num_timesteps <= self.until
+            for p in actor_parameters(self.model.policy):
+                p.requires_grad_(not frozen)
+            self.logger.record("train/critic_warmup", int(frozen))
 
         def _on_step(self) -> bool:
             return True
@@ -453,6 +487,7 @@ def _callbacks() -> dict[str, type]:
 
     return {
         "checkpoint": CheckpointCallback,
+        "critic_warmup": CriticWarmupCallback,
         "eval": EvalCurriculumCallback,
         "progress": RichProgressCallback,
     }
@@ -602,7 +637,7 @@ def train(
                 policy, venv, learning_rate=lr, n_steps=n_steps,
                 batch_size=ppo.minibatch_size, n_epochs=ppo.n_epochs, gamma=ppo.gamma,
                 gae_lambda=ppo.gae_lambda, clip_range=ppo.clip_range, ent_coef=ppo.ent_coef,
-                vf_coef=ppo.vf_coef, max_grad_norm=ppo.max_grad_norm,
+                vf_coef=ppo.vf_coef, max_grad_norm=ppo.max_grad_norm, target_kl=ppo.target_kl,
                 policy_kwargs={
                     "net_arch": {"pi": list(ppo.net_arch.pi), "vf": list(ppo.net_arch.vf)},
                     "activation_fn": {"relu": nn.ReLU, "tanh": nn.Tanh}[ppo.activation],
@@ -657,6 +692,8 @@ def train(
         _write_json(manifest_path, manifest)
         cbs = _callbacks()
         callbacks: list[Any] = [cbs["eval"](t), cbs["checkpoint"](t)]
+        if ppo.critic_warmup > 0:
+            callbacks.append(cbs["critic_warmup"](ppo.critic_warmup))
         if progress:
             callbacks.append(cbs["progress"](tr.total_steps, done))
         remaining = max(tr.total_steps - done, 0)

@@ -125,6 +125,17 @@ class PPOConfig(_Strict):
     ent_coef: float = Field(0.005, ge=0, description="entropy bonus weight")
     vf_coef: float = Field(0.22, ge=0, description="value loss weight")
     max_grad_norm: float = Field(0.5, gt=0, description="gradient clipping")
+    target_kl: float | None = Field(
+        None, gt=0,
+        description="stop an update's epochs early once the approximate KL between the old "
+        "and new policy exceeds 1.5 x this (SB3); null: always run n_epochs",
+    )
+    critic_warmup: int = Field(
+        0, ge=0,
+        description="env steps (counted from the run's step 0) during which only the critic "
+        "learns: the actor's parameters (its extractor, MLP, mean and log-std) stay frozen, so "
+        "a warm-started actor meets advantages from a fitted critic",
+    )
     net_arch: NetArch = Field(default_factory=NetArch)
     activation: Literal["relu", "tanh"] = Field("relu", description="hidden-layer activation")
     extractor: ExtractorConfig = Field(

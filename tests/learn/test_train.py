@@ -166,3 +166,44 @@ def test_batched_vec_env_run_with_real_evaluator(tmp_path):
     assert man["steps_done"] == 64 and man["settings"]["train"]["vec_env"] == "batched"
     pol = NumpyPolicy.load(res.policy)
     assert len(pol.meta["laser"]["angles"]) == 8
+
+
+def _state(ckpt):
+    from stable_baselines3 import PPO
+
+    pol = PPO.load(ckpt / "model.zip", device="cpu").policy
+    from arena.learn.train import actor_parameters
+
+    actor = {id(p) for p in actor_parameters(pol)}
+    named = dict(pol.named_parameters())
+    return ({k: v.detach().clone() for k, v in named.items() if id(v) in actor},
+            {k: v.detach().clone() for k, v in named.items() if id(v) not in actor})
+
+
+def test_critic_warmup_freezes_the_actor_then_releases_it(tmp_path):
+    cfg = small_cfg("task.obstacles={type: random, static: 0, dynamic: 1}",
+                    "learning.env.action={type: continuous, normalize: true}")
+    data = json.loads(json.dumps(TINY))
+    data["ppo"].update(critic_warmup=64, target_kl=0.05, ent_coef=0.01)
+    data["train"].update(total_steps=96)
+    settings = TrainSettings.model_validate(data)
+    run = tmp_path / "run"
+    train(cfg, settings, run, robot=small_robot(8))
+    from stable_baselines3 import PPO
+
+    assert PPO.load(run / "checkpoints/step_96/model.zip", device="cpu").target_kl == 0.05
+    a32, c32 = _state(run / "checkpoints/step_32")
+    a64, c64 = _state(run / "checkpoints/step_64")
+    a96, _ = _state(run / "checkpoints/step_96")
+    assert "log_std" in a32 and any("action_net" in k for k in a32)
+    assert any("value_net" in k for k in c32)
+    # updates after the rollouts ending at steps 32 and 64 train the critic only
+    for k in a32:
+        assert torch_equal(a32[k], a64[k]), k
+    assert any(not torch_equal(c32[k], c64[k]) for k in c32)
+    # the update after step 96 trains the actor too
+    assert any(not torch_equal(a64[k], a96[k]) for k in a64)
+
+
+def torch_equal(a, b):
+    return bool((a == b).all())
