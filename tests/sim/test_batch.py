@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -184,8 +186,14 @@ def test_reset_world_with_another_map_keeps_shared_map(episodes: list[Episode]) 
 
 
 @pytest.mark.parametrize("parallel_min_worlds", [1, 100])  # thread pool and serial path
-def test_scans_bit_identical_to_lidar2d(episodes: list[Episode], parallel_min_worlds: int) -> None:
+@pytest.mark.parametrize("faces_per_beam", [math.inf, -1.0])  # walls as faces / grid walk
+def test_scans_bit_identical_to_lidar2d(
+    episodes: list[Episode], parallel_min_worlds: int, faces_per_beam: float, monkeypatch
+) -> None:
+    import arena.sensors.lidar2d as mod
     from arena.sensors.lidar2d import Lidar2D
+
+    monkeypatch.setattr(mod, "FACES_PER_BEAM", faces_per_beam)
 
     sim = BatchSim(8, BatchSim.Params(parallel_min_worlds=parallel_min_worlds))
     s = sim.reset(episodes, np.random.default_rng(2))

@@ -9,7 +9,9 @@ Per-world static data is packed as follows (``N`` worlds):
   blocking cell, as :class:`~arena.sensors.lidar2d.Lidar2D` stores it) starts at ``offs[i]``;
 * obstacle edges: ``(N, S, 2)`` padded arrays with ``seg_n[i]`` valid rows and ``seg_owner``
   the obstacle each edge belongs to (an obstacle's edges are consecutive and closed);
-* pedestrians: ``(N, P, ...)`` padded arrays with ``ped_n[i]`` valid rows.
+* pedestrians: ``(N, P, ...)`` padded arrays with ``ped_n[i]`` valid rows;
+* wall faces (:func:`arena.sensors.lidar2d.wall_faces`): ``(N, F, 4)`` padded with
+  ``face_n[i]`` valid rows; ``face_n[i] = -1`` casts world ``i``'s walls on its distance map.
 """
 
 from __future__ import annotations
@@ -23,6 +25,7 @@ from numpy.typing import NDArray
 from arena.sensors.lidar2d import (
     _AXIS_SNAP,
     _beam_window,
+    _cast_faces,
     _cast_grid_many,
     _circle_hit,
     _fast_atan2,
@@ -67,6 +70,7 @@ def _scan_one(
     range_min: float, range_max: float, distg: F32, res: float, gx0: float, gy0: float,
     circ_xy: F64, circ_r: F64, seg_a: F64, seg_b: F64,
     dx: F64, dy: F64, tlim: F64, tg: F64, t1s: F64, active: I64, pending: I64, best: F64,
+    faces: F64, use_faces: bool,
 ) -> None:
     """One robot's scan into ``best``, with caller-provided scratch arrays.
 
@@ -122,7 +126,10 @@ def _scan_one(
     _segments_into(best, dx, dy, ox, oy, a0, inc, range_max, seg_a, seg_b, _NO_OWNER, -1)
     for i in range(n):
         tlim[i] = best[i] * inv_res
-    _cast_grid_many(gox, goy, dx, dy, tlim, distg, tg, t1s, active, pending)
+    if use_faces:
+        _cast_faces(gox, goy, dx, dy, tlim, faces, distg.shape[1], distg.shape[0], a0, inc, tg)
+    else:
+        _cast_grid_many(gox, goy, dx, dy, tlim, distg, tg, t1s, active, pending)
     for i in range(n):
         if tg[i] * res < best[i]:
             best[i] = tg[i] * res
@@ -139,7 +146,7 @@ def scan_worlds(
     dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
     ped_pos: F64, ped_r: F64, ped_n: I64,
     seg_a: F64, seg_b: F64, seg_n: I64, out: F64,
-    scratch_f: F64, scratch_i: I64,
+    scratch_f: F64, scratch_i: I64, faces: F64, face_n: I64,
 ) -> None:
     """Scan every world whose ``due`` flag is set into ``out[i]`` (``(N, B)`` ranges, m).
 
@@ -155,7 +162,7 @@ def scan_worlds(
         _scan_world(
             i, poses, mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
             dist_flat, offs, shapes, res, origin, ped_pos, ped_r, ped_n,
-            seg_a, seg_b, seg_n, out, scratch_f, scratch_i,
+            seg_a, seg_b, seg_n, out, scratch_f, scratch_i, faces, face_n,
         )
 
 
@@ -166,7 +173,7 @@ def scan_worlds_serial(
     dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
     ped_pos: F64, ped_r: F64, ped_n: I64,
     seg_a: F64, seg_b: F64, seg_n: I64, out: F64,
-    scratch_f: F64, scratch_i: I64,
+    scratch_f: F64, scratch_i: I64, faces: F64, face_n: I64,
 ) -> None:
     """:func:`scan_worlds` on the calling thread (no thread-pool launch: small ``N``)."""
     for i in range(poses.shape[0]):
@@ -175,7 +182,7 @@ def scan_worlds_serial(
         _scan_world(
             i, poses, mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
             dist_flat, offs, shapes, res, origin, ped_pos, ped_r, ped_n,
-            seg_a, seg_b, seg_n, out, scratch_f, scratch_i,
+            seg_a, seg_b, seg_n, out, scratch_f, scratch_i, faces, face_n,
         )
 
 
@@ -186,7 +193,7 @@ def _scan_world(
     dist_flat: F32, offs: I64, shapes: I64, res: F64, origin: F64,
     ped_pos: F64, ped_r: F64, ped_n: I64,
     seg_a: F64, seg_b: F64, seg_n: I64, out: F64,
-    scratch_f: F64, scratch_i: I64,
+    scratch_f: F64, scratch_i: I64, faces: F64, face_n: I64,
 ) -> None:
     distg = _world_map(dist_flat, offs, shapes, i)
     n = ped_n[i]
@@ -197,6 +204,7 @@ def _scan_world(
         poses[i], mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
         distg, res[i], origin[i, 0], origin[i, 1], ped_pos[i, :n], ped_r[i, :n],
         seg_a[i, :s], seg_b[i, :s], sf[0], sf[1], sf[2], sf[3], sf[4], si[0], si[1], out[i],
+        faces[i, : max(face_n[i], 0)], face_n[i] >= 0,
     )
 
 
@@ -576,6 +584,7 @@ def _step_world(
     wall: B1, obstacle: I64, agent: I64,
     due: B1, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
     range_min: float, range_max: float, scans: F64, scratch_f: F64, scratch_i: I64,
+    faces: F64, face_n: I64,
 ) -> None:
     """World ``w``'s crowd, contacts, collision response and lidar: the stages in step order.
 
@@ -605,7 +614,7 @@ def _step_world(
         _scan_world(
             w, new_poses, mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
             dist_flat, offs, shapes, res, origin, peds, radii, ped_n,
-            seg_a, seg_b, seg_n, scans, scratch_f, scratch_i,
+            seg_a, seg_b, seg_n, scans, scratch_f, scratch_i, faces, face_n,
         )
 
 
@@ -621,6 +630,7 @@ def step_worlds(
     wall: B1, obstacle: I64, agent: I64,
     due: B1, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
     range_min: float, range_max: float, scans: F64, scratch_f: F64, scratch_i: I64,
+    faces: F64, face_n: I64,
 ) -> None:
     """One whole simulation step of every world in a single parallel region.
 
@@ -636,7 +646,7 @@ def step_worlds(
             wp_idx, rand, rand_k, dist_flat, offs, shapes, res, origin, seg_a, seg_b, seg_owner,
             seg_n, radius, prm, dt, out_pos, out_vel, old_poses, new_poses, new_twists,
             new_steer, steer, wall, obstacle, agent, due, mount, cos_a, sin_a, angle_min, inc,
-            range_min, range_max, scans, scratch_f, scratch_i,
+            range_min, range_max, scans, scratch_f, scratch_i, faces, face_n,
         )
 
 
@@ -652,6 +662,7 @@ def step_worlds_serial(
     wall: B1, obstacle: I64, agent: I64,
     due: B1, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
     range_min: float, range_max: float, scans: F64, scratch_f: F64, scratch_i: I64,
+    faces: F64, face_n: I64,
 ) -> None:
     """:func:`step_worlds` on the calling thread (no thread-pool launch: small ``N``)."""
     for w in range(old_poses.shape[0]):
@@ -660,5 +671,5 @@ def step_worlds_serial(
             wp_idx, rand, rand_k, dist_flat, offs, shapes, res, origin, seg_a, seg_b, seg_owner,
             seg_n, radius, prm, dt, out_pos, out_vel, old_poses, new_poses, new_twists,
             new_steer, steer, wall, obstacle, agent, due, mount, cos_a, sin_a, angle_min, inc,
-            range_min, range_max, scans, scratch_f, scratch_i,
+            range_min, range_max, scans, scratch_f, scratch_i, faces, face_n,
         )

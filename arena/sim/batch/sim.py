@@ -52,7 +52,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from arena.core.errors import SimulationError
 from arena.maps.grid import OccupancyGrid
 from arena.robots.kinematics.base import Kinematics, KinematicState
-from arena.sensors.lidar2d import _add_noise
+from arena.sensors.lidar2d import _add_noise, use_wall_faces, wall_faces
 from arena.sensors.spec import LidarSpec
 from arena.sim.backend import split_rng
 from arena.sim.batch import kernels as K
@@ -224,6 +224,9 @@ class BatchSim:
         self._shapes = np.ones((n, 2), dtype=np.int64)
         self._res = np.ones(n)
         self._origin = np.zeros((n, 2))
+        # wall faces (Lidar2D's "Wall faces"): (N, F, 4) padded, ``face_n[i] = -1``: walk the grid
+        self._faces = np.zeros((n, 0, 4))
+        self._face_n = np.full(n, -1, dtype=np.int64)
         # obstacle edges
         self._seg_a = np.zeros((n, 0, 2))
         self._seg_b = np.zeros((n, 0, 2))
@@ -377,7 +380,7 @@ class BatchSim:
                 old, new_p, new_t, new_s, self._steer, wall, obstacle, agent,
                 due, self._mount, self._cos, self._sin, spec.angle_min, self._inc,
                 spec.range_min, spec.range_max, self._scans, self._scratch_f,
-                self._scratch_i,
+                self._scratch_i, self._faces, self._face_n,
             )
         finally:
             numba.set_parallel_chunksize(previous_chunk)
@@ -479,7 +482,7 @@ class BatchSim:
             spec.range_min, spec.range_max,
             self._dist, self._offs, self._shapes, self._res, self._origin,
             self._pos, self._pradii, self._ped_n, self._seg_a, self._seg_b, self._seg_n,
-            self._scans, self._scratch_f, self._scratch_i,
+            self._scans, self._scratch_f, self._scratch_i, self._faces, self._face_n,
         )
         if spec.noise_std > 0.0:
             self._noise(due)
@@ -580,6 +583,16 @@ class BatchSim:
         self._shapes[i] = (g.height, g.width)
         self._res[i] = g.resolution
         self._origin[i] = g.origin[0], g.origin[1]
+        faces = wall_faces(g)
+        if use_wall_faces(faces, spec.num_beams):
+            if len(faces) > self._faces.shape[1]:
+                grown = np.zeros((self.num_worlds, len(faces), 4))
+                grown[:, : self._faces.shape[1]] = self._faces
+                self._faces = grown
+            self._faces[i, : len(faces)] = faces
+            self._face_n[i] = len(faces)
+        else:
+            self._face_n[i] = -1
         # obstacles
         s = 0
         for j, ob in enumerate(ep.obstacles):
