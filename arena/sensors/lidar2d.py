@@ -84,7 +84,7 @@ _AXIS_SNAP = 1e-12
 _TWO_PI = 2.0 * math.pi
 #: A map's walls are cast as faces (:func:`wall_faces`) while it has at most this many faces per
 #: beam; beyond that the per-face set-up costs more than walking the grid.
-FACES_PER_BEAM = 1.0
+FACES_PER_BEAM = 2.0
 
 
 # ------------------------------------------------------------------------------------------------
@@ -567,7 +567,8 @@ def _segments_into(
 def _cast_faces(
     gox: float, goy: float, dx: NDArray[np.float64], dy: NDArray[np.float64],
     tlim: NDArray[np.float64], faces: NDArray[np.float64], w: int, h: int, a0: float,
-    inc: float, t_out: NDArray[np.float64],
+    inc: float, t_out: NDArray[np.float64], inv_dx: NDArray[np.float64],
+    inv_dy: NDArray[np.float64],
 ) -> None:
     """First touch of every beam with a wall face, in grid units (see "Wall faces" above).
 
@@ -587,6 +588,8 @@ def _cast_faces(
         a0: direction of beam 0 (rad, world frame).
         inc: angle between beams (rad; 0: test every beam).
         t_out: ``(n,)`` output: hit parameter (cells) or ``inf``.
+        inv_dx: ``(n,)`` scratch (``1 / dx``).
+        inv_dy: ``(n,)`` scratch (``1 / dy``).
     """
     n = dx.shape[0]
     tmax = 0.0
@@ -594,6 +597,11 @@ def _cast_faces(
         t_out[i] = math.inf
         if tlim[i] > tmax:
             tmax = tlim[i]
+        # The grid walk's boundary formula is (line − origin) · (1 / d): the same floats here.
+        # A beam parallel to a face gets ±inf (or NaN on the face's line), which never hits;
+        # the faces across the ends catch a beam running along a face.
+        inv_dx[i] = 1.0 / dx[i] if dx[i] != 0.0 else math.inf
+        inv_dy[i] = 1.0 / dy[i] if dy[i] != 0.0 else math.inf
     for f in range(faces.shape[0]):
         kind = faces[f, 0]
         line = faces[f, 1]
@@ -610,9 +618,6 @@ def _cast_faces(
         # A face is seen from one side only: kinds 0 and 2 from below the line, 1 and 3 above.
         if rel < 0.0 if (kind == 0.0 or kind == 2.0) else rel > 0.0:
             continue
-        # A beam from off the map that touches a wall on the map's edge does so where it enters
-        # the map, which the walk computes by division (_clip_to_map); do the same there.
-        entry = line == (0.0 if (kind == 0.0 or kind == 2.0) else (w if vertical else h))
         gap = lo - along if along < lo else (along - hi if along > hi else 0.0)
         if rel * rel + gap * gap > tmax * tmax:
             continue
@@ -630,32 +635,35 @@ def _cast_faces(
             i0, i1, j0, j1 = _beam_window(phi_a, dphi, a0, inc, n)
         else:
             i0, i1, j0, j1 = _beam_window(phi_a + dphi, -dphi, a0, inc, n)
+        inv_across = inv_dx if vertical else inv_dy
+        d_along = dy if vertical else dx
+        # A beam from off the map that touches a wall on the map's edge does so where it enters
+        # the map, which the walk computes by division (_clip_to_map): do the same there.
+        if line == (0.0 if (kind == 0.0 or kind == 2.0) else (w if vertical else h)):
+            d_across = dx if vertical else dy
+            for i in range(n):
+                if i0 <= i <= i1 or j0 <= i <= j1:
+                    _face_hit(t_out, i, rel / d_across[i] if d_across[i] != 0.0 else math.inf,
+                              along, d_along, lo, hi)
+            continue
         for i in range(i0, i1 + 1):
-            _face_hit(t_out, i, dx, dy, vertical, rel, along, lo, hi, entry)
+            _face_hit(t_out, i, rel * inv_across[i], along, d_along, lo, hi)
         for i in range(j0, j1 + 1):
-            _face_hit(t_out, i, dx, dy, vertical, rel, along, lo, hi, entry)
+            _face_hit(t_out, i, rel * inv_across[i], along, d_along, lo, hi)
 
 
 @njit(cache=True, fastmath=False, inline="always")
 def _face_hit(
-    t_out: NDArray[np.float64], i: int, dx: NDArray[np.float64], dy: NDArray[np.float64],
-    vertical: bool, rel: float, along: float, lo: float, hi: float, entry: bool,
+    t_out: NDArray[np.float64], i: int, t: float, along: float, d_along: NDArray[np.float64],
+    lo: float, hi: float,
 ) -> None:
-    """Lower ``t_out[i]`` to beam ``i``'s touch of one face (closed, widened by CORNER_EPS)."""
-    if vertical:
-        d = dx[i]
-        e = dy[i]
-    else:
-        d = dy[i]
-        e = dx[i]
-    if d == 0.0:
-        return  # parallel to the face: the faces across its ends catch a beam along it
-    # the grid walk's formulas, so that the hit is the same float
-    t = rel / d if entry else rel * (1.0 / d)
-    if t < 0.0 or t >= t_out[i]:
-        return
-    u = along + t * e
-    if lo - CORNER_EPS <= u <= hi + CORNER_EPS:
+    """Lower ``t_out[i]`` to ``t`` if beam ``i`` meets the face's line at ``t`` within the face.
+
+    The face is closed and widened by :data:`CORNER_EPS` at both ends; one branch so that the
+    compiler can keep the loop tight (``t`` may be ±inf or NaN for a parallel beam: no hit).
+    """
+    u = along + t * d_along[i]
+    if t >= 0.0 and t < t_out[i] and u >= lo - CORNER_EPS and u <= hi + CORNER_EPS:
         t_out[i] = t
 
 
@@ -708,6 +716,7 @@ def _scan_kernel(
     tlim = np.empty(n)
     tg = np.empty(n)
     t1s = np.empty(n)
+    t2s = np.empty(n)
     active = np.empty(n, dtype=np.int64)
     pending = np.empty(n, dtype=np.int64)
     inv_res = 1.0 / res
@@ -778,7 +787,10 @@ def _scan_kernel(
         for i in range(n):
             tlim[i] = best[i] * inv_res
         if use_faces:
-            _cast_faces(gox, goy, dx, dy, tlim, faces, distg.shape[1], distg.shape[0], a0, inc, tg)
+            _cast_faces(
+                gox, goy, dx, dy, tlim, faces, distg.shape[1], distg.shape[0], a0, inc, tg,
+                t1s, t2s,
+            )
         else:
             _cast_grid_many(gox, goy, dx, dy, tlim, distg, tg, t1s, active, pending)
         for i in range(n):

@@ -69,8 +69,8 @@ def _scan_one(
     pose: F64, mount: F64, cos_a: F64, sin_a: F64, angle_min: float, inc: float,
     range_min: float, range_max: float, distg: F32, res: float, gx0: float, gy0: float,
     circ_xy: F64, circ_r: F64, seg_a: F64, seg_b: F64,
-    dx: F64, dy: F64, tlim: F64, tg: F64, t1s: F64, active: I64, pending: I64, best: F64,
-    faces: F64, use_faces: bool,
+    dx: F64, dy: F64, tlim: F64, tg: F64, t1s: F64, t2s: F64, active: I64, pending: I64,
+    best: F64, faces: F64, use_faces: bool,
 ) -> None:
     """One robot's scan into ``best``, with caller-provided scratch arrays.
 
@@ -127,7 +127,10 @@ def _scan_one(
     for i in range(n):
         tlim[i] = best[i] * inv_res
     if use_faces:
-        _cast_faces(gox, goy, dx, dy, tlim, faces, distg.shape[1], distg.shape[0], a0, inc, tg)
+        _cast_faces(
+            gox, goy, dx, dy, tlim, faces, distg.shape[1], distg.shape[0], a0, inc, tg, t1s,
+            t2s,
+        )
     else:
         _cast_grid_many(gox, goy, dx, dy, tlim, distg, tg, t1s, active, pending)
     for i in range(n):
@@ -153,7 +156,7 @@ def scan_worlds(
     Each world is cast as Arena's single-robot kernel
     (:func:`arena.sensors.lidar2d._scan_kernel`) casts it, on its own map, pedestrians (solid
     circles) and obstacle edges, so a world's scan is bit-identical to :meth:`Lidar2D.scan` of
-    the same scene. ``scratch_f`` ``(N, 5, B)`` and ``scratch_i`` ``(N, 2, B)`` are per-world
+    the same scene. ``scratch_f`` ``(N, 6, B)`` and ``scratch_i`` ``(N, 2, B)`` are per-world
     work arrays (nothing is allocated per call).
     """
     for i in prange(poses.shape[0]):
@@ -203,7 +206,8 @@ def _scan_world(
     _scan_one(
         poses[i], mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
         distg, res[i], origin[i, 0], origin[i, 1], ped_pos[i, :n], ped_r[i, :n],
-        seg_a[i, :s], seg_b[i, :s], sf[0], sf[1], sf[2], sf[3], sf[4], si[0], si[1], out[i],
+        seg_a[i, :s], seg_b[i, :s], sf[0], sf[1], sf[2], sf[3], sf[4], sf[5], si[0], si[1],
+        out[i],
         faces[i, : max(face_n[i], 0)], face_n[i] >= 0,
     )
 

@@ -208,7 +208,7 @@ class BatchSim:
         self._step = np.zeros(n, dtype=np.int64)
         self._last_scan = np.full(n, -math.inf)
         self._scans = np.zeros((n, 1))
-        self._scratch_f = np.zeros((n, 5, 0))  # per-world lidar work arrays (_set_spec sizes)
+        self._scratch_f = np.zeros((n, 6, 0))  # per-world lidar work arrays (_set_spec sizes)
         self._scratch_i = np.zeros((n, 2, 0), dtype=np.int64)
         self._wall = np.zeros(n, dtype=bool)
         self._obstacle = np.full(n, -1, dtype=np.int64)
@@ -658,7 +658,7 @@ class BatchSim:
             self._scans = np.full((self.num_worlds, spec.num_beams), spec.range_max)
         b = spec.num_beams
         if self._scratch_f.shape[2] != b:
-            self._scratch_f = np.zeros((self.num_worlds, 5, b))
+            self._scratch_f = np.zeros((self.num_worlds, 6, b))
             self._scratch_i = np.zeros((self.num_worlds, 2, b), dtype=np.int64)
 
     def _regroup(self) -> None:
