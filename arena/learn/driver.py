@@ -25,7 +25,7 @@ from scipy import ndimage
 import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.loader import load_config
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ConfigError, PlanningError, StartOccupied
+from arena.core.errors import ConfigError, PlanningError, SamplingError, StartOccupied
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
@@ -48,6 +48,8 @@ from arena.sim.backend import BACKENDS, SimulatorBackend
 from arena.sim.state import SimState
 from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator
+from arena.tasks.robot_modes.random import sample_start_goal
+from arena.tasks.world import WorldSampler, wall_distance_map
 
 FloatArray = NDArray[np.float64]
 
@@ -145,6 +147,11 @@ class SubgoalTracker:
                 self._replan(i, poses[i], goals[i], time)
         self._subgoals(poses, goals)
 
+    def restart(self, i: int, pose: FloatArray, goal: FloatArray, time: float) -> None:
+        """Plan robot ``i`` afresh (a new start or goal) and place its subgoal."""
+        self._replan(i, pose, goal, time)
+        self.current[i] = subgoal_on_path(self.paths[i], pose[:2], self.cfg.horizon)
+
     def _subgoals(self, poses: FloatArray, goals: FloatArray) -> None:
         for i in range(poses.shape[0]):
             self.current[i] = subgoal_on_path(self.paths[i], poses[i, :2], self.cfg.horizon)
@@ -209,6 +216,11 @@ class EpisodeDriver:
         self.state: SimState | None = None
         self.steps = 0
         r = self.n_robots
+        # steps since each robot's start (differ from ``steps`` only after a respawn)
+        self.robot_steps = np.zeros(r, dtype=np.int64)
+        self._episode_index = -1
+        self._respawns = 0
+        self._wall: FloatArray | None = None  # the episode's wall distance (respawns)
         self.scans = np.zeros((r, self.env_cfg.observation.laser_stack, self.obs_builder.beams))
         self.last_action = np.zeros((r, 3))
         self.goals = np.zeros((r, 3))
@@ -248,6 +260,10 @@ class EpisodeDriver:
         crowd = CrowdSimulator.build(self.cfg.crowd, self.cfg.pedestrians)
         self.state = self.backend.reset(ep, crowd, derive_rng(self.seed, "episode", idx, "sim"))
         self.steps = 0
+        self.robot_steps = np.zeros(self.n_robots, dtype=np.int64)
+        self._episode_index = idx
+        self._respawns = 0
+        self._wall = None
         self.goals = np.array([s.goal.as_array() for s in ep.robots])
         self.last_action[:] = 0.0
         self.active[:] = True
@@ -466,6 +482,7 @@ class EpisodeDriver:
                 self.state = self.backend.step(cmd, self.dt)
                 collision |= self.state.collisions.any
         self.steps += 1
+        self.robot_steps += 1
         return collision
 
     def _push_scans(self) -> FloatArray:
@@ -495,7 +512,6 @@ class EpisodeDriver:
     ) -> RewardInput:
         """The batched reward input of the step just taken (``(r, …)`` arrays)."""
         c = self._consts
-        r = self.n_robots
         pos, _, kind, _, mask = peds
         d = pos - poses[:, None, :2]
         ped_d = np.hypot(d[..., 0], d[..., 1])
@@ -514,7 +530,9 @@ class EpisodeDriver:
             heading=poses[:, 2].copy(),
             prev_heading=prev_heading,
             dt=c["dt"],
-            step=np.array([self.steps] * r, dtype=np.int64),
+            # one robot: robot_steps is not kept (the scalar path counts self.steps only)
+            step=(self.robot_steps.copy() if self.n_robots > 1
+                  else np.array([self.steps], dtype=np.int64)),
             max_steps=c["max_steps"],
             ped_distance=ped_d,
             ped_kind=kind if kind.dtype == np.int64 else kind.astype(np.int64),
@@ -531,7 +549,8 @@ class EpisodeDriver:
         r: int,
     ) -> StepResult:
         """Episode-end flags and outcomes, then :meth:`_result`."""
-        limit = self._at_limit()
+        world_limit = self._at_time_limit()
+        steps_l = self.robot_steps.tolist()
         # Per robot in Python (r is small): terminated on arrival, contact or a term ending the
         # episode with success/collision; truncated at the limits or when another term ends it.
         reached_l, collision_l = goal_reached.tolist(), collision.tolist()
@@ -543,6 +562,7 @@ class EpisodeDriver:
             hit = reason_l[i] == _COLLISION
             term_reason = hit or reason_l[i] == _SUCCESS
             terminated_i = reached_l[i] or collision_l[i] or (done_l[i] and term_reason)
+            limit = world_limit or steps_l[i] >= self.env_cfg.max_steps
             truncated_i = not terminated_i and (limit or (done_l[i] and not term_reason))
             term_l.append(terminated_i)
             trunc_l.append(truncated_i)
@@ -562,11 +582,67 @@ class EpisodeDriver:
 
     def _at_limit(self) -> bool:
         """The episode's step or time limit is reached (truncation)."""
+        return (self.steps >= self.env_cfg.max_steps) or self._at_time_limit()
+
+    def _at_time_limit(self) -> bool:
+        """The episode's time limit is reached (every robot is truncated)."""
         assert self.state is not None
         assert self.episode is not None
-        return (self.steps >= self.env_cfg.max_steps) or (
-            self.state.time >= self.episode.time_limit - 1e-9
-        )
+        return bool(self.state.time >= self.episode.time_limit - 1e-9)
+
+    # -- respawns (multi-robot training) -------------------------------------------------------
+    def respawn(self, i: int, min_goal_distance: float, clearance: float) -> bool:
+        """Give robot ``i`` a new random start and goal in the running world.
+
+        For multi-robot training (Long et al. 2018): a robot that arrived or collided starts
+        over while the others drive on. The start and goal are drawn like ``robots.random``
+        draws them (``radius + clearance`` from walls and obstacles, one connected region,
+        ``min_goal_distance`` apart), also keeping that clearance from where the other robots
+        stand and from the people; the robot is teleported there at rest, its laser stack
+        filled with its fresh scan, its last action zeroed, its step count restarted and its
+        path planned. The draws come from ``derive_rng(seed, "episode", index, "respawn", k)``
+        (``k`` counts the episode's respawns), so a rollout stays reproducible.
+
+        Returns:
+            ``False`` when no start/goal pair was found (the robot is left as it was).
+        """
+        assert self.state is not None
+        assert self.episode is not None
+        ep = self.episode
+        if self._wall is None:
+            self._wall = wall_distance_map(ep.grid)
+        world = WorldSampler(ep.grid, ep.obstacles, wall_distance=self._wall)
+        poses = self.state.robots.poses
+        for j in range(self.n_robots):
+            if j != i:
+                world.forbid(poses[j, :2], self.radius)
+        agents = self.state.agents
+        for xy, rad in zip(agents.positions, agents.radii, strict=True):
+            world.forbid(xy, float(rad))
+        rng = derive_rng(self.seed, "episode", self._episode_index, "respawn", self._respawns)
+        self._respawns += 1
+        try:
+            start, goal = sample_start_goal(
+                world, self.radius + clearance, min_goal_distance, rng, what=f"robot {i} respawn"
+            )
+        except SamplingError:
+            return False
+        self.state = self.backend.teleport(i, start)
+        self.goals = self.goals.copy()
+        self.goals[i] = goal.as_array()
+        self.last_action = self.last_action.copy()
+        self.last_action[i] = 0.0
+        self.scans = self.scans.copy()
+        self.scans[i] = self.state.robots.scans[i][None, :]
+        self.robot_steps[i] = 0
+        self.active[i] = True
+        if self.subgoals is not None:
+            self.subgoals.restart(i, self.state.robots.poses[i], self.goals[i], self.state.time)
+        return True
+
+    def observe(self) -> Obs:
+        """The observation of every robot in the current state."""
+        return self.obs_builder.build(self._obs_input())
 
     def _result(
         self,

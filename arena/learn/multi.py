@@ -109,6 +109,20 @@ class MultiRobotEnv(ParallelEnv[str, Any, Any]):
         self.agents = [a for a in self.agents if not (term[a] or trunc[a])]
         return obs, rew, term, trunc, info
 
+    def respawn(self, agent: str, min_goal_distance: float, clearance: float) -> Any | None:
+        """Bring a done ``agent`` back with a new start and goal (:meth:`EpisodeDriver.respawn`).
+
+        Returns:
+            Its first observation, or ``None`` when no start/goal pair was found (it stays
+            done).
+        """
+        i = self._index[agent]
+        if not self.driver.respawn(i, min_goal_distance, clearance):
+            return None
+        if agent not in self.agents:
+            self.agents = [a for a in self.possible_agents if a in self.agents or a == agent]
+        return self.driver.obs_builder.single(self.driver.observe(), i)
+
     def render(self) -> Any:
         """An RGB frame in ``rgb_array`` mode, else ``None``."""
         if self.render_mode != "rgb_array" or self.driver.state is None:

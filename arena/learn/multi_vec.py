@@ -8,12 +8,22 @@ parameter-shared training). Slots are ordered world by world, robot by robot.
 Episode ends: SB3 needs every slot to step every step, while in
 :class:`~arena.learn.multi.MultiRobotEnv` a robot that is done (goal, collision) parks where it
 stands until the others finish. A parked robot's slot would feed PPO transitions its actions
-do not influence, so here the first robot to finish ends its world's episode: the finished
-robots report ``done`` as terminated, the others as truncated (``TimeLimit.truncated``, so PPO
-bootstraps their value from ``terminal_observation``), and the world restarts in the same step
-with its next episode (SB3's autoreset convention); the cut robots' ``info["outcome"]`` reads
-``"cut"``. A world's step/time limit truncates all of its robots. Each ending slot's info
-carries SB3's ``episode`` record (return, length) and ``is_success``.
+do not influence, so a finished robot's slot must restart at once, in one of two ways:
+
+* ``respawn=True`` (Long et al.'s training): the finished robot gets a new start and goal in
+  the running world (:meth:`~arena.learn.driver.EpisodeDriver.respawn`) while the others
+  drive on; its slot reports ``done`` and continues with the new start's observation. Only the
+  world's time limit (``task.timeout``) restarts the whole world. A robot's own episode ends at
+  arrival, contact or ``max_steps`` of its own. Should no start/goal pair be found (a crowded
+  map), the world restarts as below.
+* ``respawn=False``: the first robot to finish ends its world's episode: the finished robots
+  report ``done`` as terminated, the others as truncated, and the world restarts with its next
+  episode; the cut robots' ``info["outcome"]`` reads ``"cut"``.
+
+Either way a slot that ends without terminating is truncated (``TimeLimit.truncated``, so PPO
+bootstraps its value from ``terminal_observation``) and the restart happens in the same step
+(SB3's autoreset convention). Each ending slot's info carries SB3's ``episode`` record (return,
+length) and ``is_success``.
 
 The robots of one world are obstacles to each other: native2d's lidar sees the other robots'
 footprints and its contacts include robot-robot collisions.
@@ -37,6 +47,7 @@ from arena.core.types import Outcome
 from arena.learn.multi import MultiRobotEnv
 from arena.robots.model import RobotModel
 from arena.tasks.modules.staged import Staged
+from arena.tasks.robot_modes.random import RandomRobots
 
 
 class MultiRobotVecEnv(VecEnv):
@@ -46,6 +57,9 @@ class MultiRobotVecEnv(VecEnv):
         config: the experiment (``learning.env`` configures each robot's observation/reward).
         robots_per_world: robots in each world, e.g. ``[2, 3, 4]`` (9 slots).
         robot: a robot model replacing ``cfg.robot``.
+        respawn: finished robots restart in the running world (module docstring); the start
+            and goal keep the ``task.robots`` mode's ``min_goal_distance`` and ``clearance``
+            (``robots.random``'s defaults for modes without them).
     """
 
     def __init__(
@@ -53,6 +67,7 @@ class MultiRobotVecEnv(VecEnv):
         config: ExperimentConfig,
         robots_per_world: Sequence[int],
         robot: RobotModel | None = None,
+        respawn: bool = False,
     ) -> None:
         if not robots_per_world or any(int(r) < 1 for r in robots_per_world):
             raise ValueError("robots_per_world needs at least one world of >= 1 robots")
@@ -67,6 +82,11 @@ class MultiRobotVecEnv(VecEnv):
         self.render_mode: str | None = None  # read back by VecEnv.__init__
         super().__init__(int(ends[-1]), first.observation_space(agent), first.action_space(agent))
         self.keys = tuple(first.driver.obs_builder.keys)
+        self.respawn = bool(respawn)
+        params = getattr(first.driver.generator.robot_mode, "params", None)
+        defaults = RandomRobots.Params()
+        self._min_goal = float(getattr(params, "min_goal_distance", defaults.min_goal_distance))
+        self._clearance = float(getattr(params, "clearance", defaults.clearance))
         self._world_seeds: list[int | None] = [None] * len(self.worlds)
         self._actions: NDArray[Any] | None = None
         self._obs: list[dict[str, Any]] = [{} for _ in self.worlds]
@@ -105,7 +125,16 @@ class MultiRobotVecEnv(VecEnv):
             agents = env.possible_agents
             acts = {a: self._actions[sl.start + i] for i, a in enumerate(agents)}
             obs, rew, term, trunc, info = env.step(acts)
-            ended = any(term[a] or trunc[a] for a in agents)
+            finished = [a for a in agents if term[a] or trunc[a]]
+            respawned: dict[str, Any] = {}
+            if self.respawn and finished and len(finished) < len(agents):
+                for a in finished:
+                    first_obs = env.respawn(a, self._min_goal, self._clearance)
+                    if first_obs is None:
+                        respawned = {}  # no room: restart the world instead
+                        break
+                    respawned[a] = first_obs
+            ended = bool(finished) and not respawned
             for i, a in enumerate(agents):
                 j = sl.start + i
                 rewards[j] = rew[a]
@@ -114,7 +143,7 @@ class MultiRobotVecEnv(VecEnv):
                 d = infos[j]
                 d.update(info[a])
                 d["is_success"] = info[a]["outcome"] == Outcome.SUCCESS.value
-                if ended:
+                if ended or a in respawned:
                     dones[j] = True
                     d["terminal_observation"] = obs[a]
                     d["TimeLimit.truncated"] = not term[a]
@@ -126,6 +155,10 @@ class MultiRobotVecEnv(VecEnv):
                     self._len[j] = 0
             if ended:
                 obs, _ = env.reset()
+            elif respawned:
+                # the others' observations now show the respawned robots where they stand
+                full = env.driver.observe()
+                obs = {a: env.driver.obs_builder.single(full, i) for i, a in enumerate(agents)}
             self._obs[k] = obs
         return self._stack(), rewards, dones, infos
 

@@ -233,6 +233,7 @@ def make_vec_env(
     robot: RobotModel | None = None,
     seed: int | None = None,
     robots_per_world: Sequence[int] | None = None,
+    respawn: bool = False,
 ) -> Any:
     """``n_envs`` environments in SB3's ``DummyVecEnv`` or ``SubprocVecEnv``.
 
@@ -240,7 +241,7 @@ def make_vec_env(
     :class:`~arena.learn.batched.BatchedSocialNavEnv` of ``n_envs`` worlds (seeded with
     ``seed`` at its next reset when given). ``kind="multi_robot"``: a
     :class:`~arena.learn.multi_vec.MultiRobotVecEnv` with ``robots_per_world`` (summing to
-    ``n_envs``; default: one world of ``n_envs`` robots).
+    ``n_envs``; default: one world of ``n_envs`` robots) and ``respawn``.
     """
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
@@ -251,7 +252,7 @@ def make_vec_env(
         if sum(rpw) != n_envs:
             raise ConfigError(f"robots_per_world {rpw} does not sum to n_envs {n_envs}",
                               path="learning.train.robots_per_world")
-        mvenv = MultiRobotVecEnv(cfg, rpw, robot=robot)
+        mvenv = MultiRobotVecEnv(cfg, rpw, robot=robot, respawn=respawn)
         if seed is not None:
             mvenv.seed(int(seed))
         return mvenv
@@ -607,7 +608,7 @@ def train(
         staged.set_stage(int(manifest["stage"]))
 
     venv = make_vec_env(cfg, tr.n_envs, tr.vec_env, robot, seed=seed,
-                        robots_per_world=tr.robots_per_world)
+                        robots_per_world=tr.robots_per_world, respawn=tr.respawn)
     nc = ppo.normalize
     try:
         if resume:

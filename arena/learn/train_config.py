@@ -182,6 +182,12 @@ class TrainConfig(_Strict):
         None,
         description="multi_robot: robots in each world (one entry per world), summing to n_envs",
     )
+    respawn: bool = Field(
+        False,
+        description="multi_robot: a robot that arrives, collides or reaches max_steps gets a "
+        "new start and goal in its running world (Long et al.); false: the first robot to "
+        "finish ends its world's episode for all",
+    )
     seed: int | None = Field(None, ge=0, description="run seed; null: the experiment's seed")
     checkpoint_every: int = Field(100_000, ge=1, description="env steps between checkpoints")
     tensorboard: bool = Field(True, description="write TensorBoard logs to RUN/tb")
@@ -204,6 +210,8 @@ class TrainConfig(_Strict):
                 )
         elif rpw is not None:
             raise ValueError("robots_per_world only applies to vec_env multi_robot")
+        if self.respawn and self.vec_env != "multi_robot":
+            raise ValueError("respawn only applies to vec_env multi_robot")
         return self
 
 

@@ -77,6 +77,64 @@ def test_first_finisher_ends_its_world():
     assert infos[0]["is_success"] and not infos[1]["is_success"]
 
 
+def test_respawn_restarts_only_the_finisher():
+    cfg = small_cfg(*RLCA_OBS, "learning.env.max_steps=200", "task.robots.min_goal_distance=2")
+    venv = MultiRobotVecEnv(cfg, [2, 3], robot=small_robot(16), respawn=True)
+    venv.seed(3)
+    venv.reset()
+    d = venv.worlds[0].driver
+    others = d.state.robots.poses[1].copy()
+    old_goal = d.goals[0].copy()
+    d.backend._poses[0, :2] = d.goals[0, :2]  # robot 0 of world 0 arrives (test-only write)
+    obs, _, dones, infos = venv.step(np.zeros((5, 2), np.float32))
+    # only robot 0's slot ends; its world goes on, robot 1 keeps driving (it stood still)
+    assert dones.tolist() == [True, False, False, False, False]
+    assert infos[0]["outcome"] == "success" and infos[0]["is_success"]
+    assert "terminal_observation" in infos[0] and "episode" in infos[0]
+    assert venv.worlds[0].agents == ["robot_0", "robot_1"]
+    np.testing.assert_allclose(d.state.robots.poses[1], others, atol=1e-12)
+    # robot 0 has a new start and goal: min_goal_distance apart, clear of robot 1
+    start, goal = d.state.robots.poses[0], d.goals[0]
+    assert not np.allclose(goal, old_goal)
+    assert np.hypot(*(goal[:2] - start[:2])) >= 2.0
+    assert np.hypot(*(start[:2] - others[:2])) >= 2 * d.radius
+    assert d.robot_steps.tolist() == [0, 1] and d.steps == 1
+    # its new observation: fresh laser stack, zero velocity, the new goal
+    np.testing.assert_array_equal(obs["velocity"][0], 0.0)
+    np.testing.assert_array_equal(obs["lidar"][0, 0], obs["lidar"][0, 2])
+    np.testing.assert_array_equal(obs["lidar"][0, 2], d.state.robots.scans[0].astype(np.float32))
+    # robot 0's next episode counts from its respawn
+    _, _, dones, infos = venv.step(np.zeros((5, 2), np.float32))
+    assert not dones.any()
+    # the world's time limit ends every robot's episode at once and restarts the world
+    venv2 = MultiRobotVecEnv(small_cfg(*RLCA_OBS, "task.timeout=0.6"), [2], robot=small_robot(16),
+                             respawn=True)
+    venv2.seed(1)
+    venv2.reset()
+    ends = [venv2.step(np.zeros((2, 2), np.float32))[2].tolist() for _ in range(6)]  # 0.1 s
+    assert ends == [[False, False]] * 5 + [[True, True]]
+    assert venv2.worlds[0].driver.steps == 0  # the world restarted
+
+
+def test_respawn_rollouts_are_reproducible():
+    cfg = small_cfg(*RLCA_OBS, "learning.env.max_steps=200", "task.robots.min_goal_distance=1")
+
+    def run():
+        venv = MultiRobotVecEnv(cfg, [3], robot=small_robot(16), respawn=True)
+        out = _rollout(venv, 5, 60)
+        n_done = sum(int(s[2].sum()) for s in out[1:])
+        return out, n_done
+
+    a, n = run()
+    b, _ = run()
+    assert n > 0  # robots finished (collisions with random actions) and respawned
+    for x, y in zip(a[1:], b[1:], strict=True):
+        for k in x[0]:
+            np.testing.assert_array_equal(x[0][k], y[0][k])
+        np.testing.assert_array_equal(x[1], y[1])
+        np.testing.assert_array_equal(x[2], y[2])
+
+
 def test_same_seed_same_rollout():
     a = _rollout(_venv(), 7, 12)
     b = _rollout(_venv(), 7, 12)

@@ -207,3 +207,14 @@ def test_critic_warmup_freezes_the_actor_then_releases_it(tmp_path):
 
 def torch_equal(a, b):
     return bool((a == b).all())
+
+
+def test_multi_robot_only_settings_need_the_multi_robot_env():
+    with pytest.raises(ValueError, match="respawn only applies to vec_env multi_robot"):
+        TrainSettings.model_validate({"train": {"respawn": True, "vec_env": "dummy"}})
+    with pytest.raises(ValueError, match="robots_per_world only applies"):
+        TrainSettings.model_validate({"train": {"robots_per_world": [2], "vec_env": "dummy"}})
+    ok = TrainSettings.model_validate(
+        {"train": {"respawn": True, "vec_env": "multi_robot", "n_envs": 3,
+                   "robots_per_world": [1, 2]}})
+    assert ok.train.respawn
