@@ -210,3 +210,39 @@ def test_scans_bit_identical_to_lidar2d(
         m = s.ped_mask[i]
         ref = lidar.scan(s.poses[i], s.ped_positions[i][m], s.ped_radii[i][m])
         np.testing.assert_array_equal(s.scans[i], ref)
+
+
+def test_worlds_mix_wall_faces_and_grid_walk() -> None:
+    """A speckled map (thousands of faces: grid walk) next to rooms cast as faces, with the
+    padded face table growing when a later world's map has more faces."""
+    from arena.core.types import Pose2D
+    from arena.sensors.lidar2d import Lidar2D, use_wall_faces, wall_faces
+    from arena.tasks.episode import AgentSpawn, RobotSpawn
+
+    jackal = load_robot("jackal")
+    rng = np.random.default_rng(4)
+    room = np.pad(np.zeros((96, 96), bool), 2, constant_values=True)
+    pillars = room.copy()
+    pillars[20:80:10, 20:80:10] = True  # 36 more boxes: more faces than the plain room
+    speckle = room | (rng.random(room.shape) < 0.06)
+    speckle[40:60, 40:60] = False  # room for the robot
+    grids = [OccupancyGrid.from_occupied(m, 0.05) for m in (room, speckle, pillars)]
+    assert [use_wall_faces(wall_faces(g), jackal.laser.num_beams) for g in grids] == [
+        True, False, True]
+    assert len(wall_faces(grids[2])) > len(wall_faces(grids[0]))
+
+    def episode(g: OccupancyGrid) -> Episode:
+        return Episode(0, 0, "box", g, (), (RobotSpawn("r", jackal, Pose2D(2.5, 2.5, 0.3),
+                                                       Pose2D(4.0, 2.5, 0.0)),),
+                       AgentSpawn.empty(), 10.0)
+
+    sim = BatchSim(3)
+    s = sim.reset([episode(grids[0]), episode(grids[1]), episode(grids[0])],
+                  np.random.default_rng(0))
+    s = sim.reset_world(2, episode(grids[2]), np.random.default_rng(1))  # grows the table
+    lidar = Lidar2D(jackal.laser)
+    for _ in range(3):
+        s = sim.step(np.tile([[0.3, 0.0, 0.5]], (3, 1)), 0.1)
+        for i, g in enumerate(grids):
+            lidar.bind(g)
+            np.testing.assert_array_equal(s.scans[i], lidar.scan(s.poses[i]))
