@@ -608,6 +608,8 @@ class EpisodeDriver:
         """
         assert self.state is not None
         assert self.episode is not None
+        if self.n_robots < 2:
+            raise ValueError("respawn() is for multi-robot worlds; one robot starts a new episode")
         ep = self.episode
         if self._wall is None:
             self._wall = wall_distance_map(ep.grid)

@@ -195,3 +195,12 @@ def test_multi_robot_ppo_smoke_run_with_rlca_extractor_and_resume(tmp_path):
     data["train"]["total_steps"] = 128
     res2 = train(cfg, TrainSettings.model_validate(data), run, resume=True, robot=robot)
     assert res2.steps == 128 and read_run(run)["steps_done"] == 128
+
+
+def test_respawn_needs_several_robots():
+    from arena.learn.env import SocialNavEnv
+
+    env = SocialNavEnv(small_cfg(*RLCA_OBS), robot=small_robot(16))
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="multi-robot worlds"):
+        env.driver.respawn(0, 2.0, 0.25)
