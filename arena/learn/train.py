@@ -8,6 +8,8 @@
     RUN/tb/PPO_1/                    TensorBoard events (SB3's scalars + eval/success_rate,
                                      curriculum/stage)
     RUN/policy.npz                   the final actor for numpy inference (arena.learn.policy)
+    RUN/best/                        eval.keep_best: model, statistics and policy.npz of the
+                                     best evaluated checkpoint (run.json["best"]: step, rate)
 
 Training uses ``n_envs`` :class:`~arena.learn.env.SocialNavEnv` instances seeded ``seed + k``
 (``DummyVecEnv`` or ``SubprocVecEnv``; ``batched``: one batched simulator; ``multi_robot``:
@@ -23,6 +25,12 @@ Curriculum: when ``task.modules`` has a ``staged`` module, a separate evaluation
 :meth:`~arena.tasks.modules.staged.Staged.report` (its curriculum's thresholds, Arena 0.90 /
 0.65) promotes or demotes, and the new stage is applied to every training env. Training stops
 at the last stage once the success rate reaches ``curriculum.stop_success`` (Arena: 0.98).
+
+Best checkpoint: with ``eval.keep_best`` (and no ``staged`` module) the same deterministic
+evaluation runs every ``eval.every`` steps, between rollouts, and the model with the highest
+success rate so far is kept in ``RUN/best``; a resumed run keeps comparing with the recorded
+best. PPO can make a warm-started policy worse (``rlca``: 100 % → 65 % on validation
+episodes within 230 k steps), so the last checkpoint is not always the one to ship.
 
 Resume: ``resume=True`` loads the latest checkpoint of the run folder and continues to
 ``total_steps`` with the recorded config and settings; only ``total_steps`` may differ. The
@@ -52,6 +60,7 @@ from arena.robots.model import RobotModel
 
 MANIFEST = "run.json"
 CHECKPOINTS = "checkpoints"
+BEST = "best"  # eval.keep_best: the best evaluated checkpoint
 INSTALL_HINT = "pip install torch==2.13.0, then pip install 'arena[train]'"
 
 
@@ -405,8 +414,13 @@ def _callbacks() -> dict[str, type]:
         def _on_rollout_start(self) -> None:
             # between rollouts, after the previous update: the saved model has learnt from
             # every step it counts (inside a rollout the last update would be missing)
-            if self.num_timesteps - self.trainer.last_checkpoint >= self.trainer.every_ckpt:
-                self.trainer.checkpoint()
+            t = self.trainer
+            if t.keep_best is not None and self.num_timesteps - t.last_eval >= t.every_eval:
+                t.last_eval = self.num_timesteps
+                t.keep_best()
+                self.logger.record("eval/success_rate", t.last_success)
+            if self.num_timesteps - t.last_checkpoint >= t.every_ckpt:
+                t.checkpoint()
 
         def _on_step(self) -> bool:
             return True
@@ -519,6 +533,8 @@ class _Trainer:
         self.on_eval: Callable[[CurriculumState], None] | None = None
         self.last_success: float | None = None
         self.checkpoint: Callable[[], None] = lambda: None
+        # eval.keep_best: evaluate and keep the best checkpoint (no curriculum)
+        self.keep_best: Callable[[], None] | None = None
 
 
 def _check_settings(s: TrainSettings) -> int:
@@ -672,6 +688,15 @@ def train(
                 staged, evaluate, apply, tr.curriculum.stop_success
             )
         wall = {"t": time.perf_counter(), "steps": done}
+        rob = robot if robot is not None else load_robot(cfg.robot)
+
+        def export(path: Path) -> Path:
+            return export_policy(
+                model, venv if nc.norm_obs else None, path,
+                decoder=ActionDecoder(cfg.learning.env.action, rob),
+                observation=cfg.learning.env.observation.model_dump(mode="json"),
+                laser=rob.laser,
+            )
 
         def checkpoint() -> None:
             steps = int(model.num_timesteps)
@@ -690,6 +715,34 @@ def train(
             t.last_checkpoint = steps
 
         t.checkpoint = checkpoint
+        if tr.eval.keep_best:
+            if staged is not None:
+                raise ConfigError(
+                    "eval.keep_best compares success rates across the run; with a staged "
+                    "curriculum they belong to different stages", path="learning.train.eval",
+                )
+            if evaluate is None:
+                evaluator = Evaluator(cfg, tr.eval.episodes, seed + tr.eval.seed_offset, robot)
+                evaluator.model, evaluator.train_env = model, venv
+                evaluate = evaluator
+            judge = evaluate
+            best = manifest.get("best") or {}
+
+            def keep_best() -> None:
+                rate = float(judge())
+                t.last_success = rate
+                if rate <= float(best.get("success_rate", -1.0)):
+                    return
+                steps = int(model.num_timesteps)
+                (run / BEST).mkdir(parents=True, exist_ok=True)
+                model.save(run / BEST / "model.zip")
+                venv.save(str(run / BEST / "vecnormalize.pkl"))
+                export(run / BEST / "policy.npz")
+                best.update(step=steps, success_rate=rate, path=BEST)
+                manifest["best"] = dict(best)
+                _write_json(manifest_path, manifest)
+
+            t.keep_best = keep_best
         _write_json(manifest_path, manifest)
         cbs = _callbacks()
         callbacks: list[Any] = [cbs["eval"](t), cbs["checkpoint"](t)]
@@ -709,13 +762,7 @@ def train(
         rate = (steps - done) / elapsed if elapsed > 0 else 0.0
         manifest["steps_per_second"] = rate
         _write_json(manifest_path, manifest)
-        rob = robot if robot is not None else load_robot(cfg.robot)
-        policy_path = export_policy(
-            model, venv if nc.norm_obs else None, run / "policy.npz",
-            decoder=ActionDecoder(cfg.learning.env.action, rob),
-            observation=cfg.learning.env.observation.model_dump(mode="json"),
-            laser=rob.laser,
-        )
+        policy_path = export(run / "policy.npz")
         if evaluator is not None:
             evaluator.close()
     finally:

@@ -156,6 +156,12 @@ class EvalConfig(_Strict):
     seed_offset: int = Field(
         10000, ge=0, description="the eval env's seed is the run's seed + this"
     )
+    keep_best: bool = Field(
+        False,
+        description="without a staged curriculum: evaluate every `every` steps anyway and keep "
+        "the checkpoint with the highest success rate in RUN/best (model, statistics, "
+        "policy.npz); a warm-started policy may get worse under PPO",
+    )
 
 
 class CurriculumTrainConfig(_Strict):

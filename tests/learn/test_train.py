@@ -218,3 +218,34 @@ def test_multi_robot_only_settings_need_the_multi_robot_env():
         {"train": {"respawn": True, "vec_env": "multi_robot", "n_envs": 3,
                    "robots_per_world": [1, 2]}})
     assert ok.train.respawn
+
+
+def test_keep_best_keeps_the_best_evaluated_checkpoint_and_resumes_it(tmp_path):
+    from stable_baselines3 import PPO
+
+    cfg = small_cfg("task.obstacles={type: random, static: 0, dynamic: 1}")
+    data = json.loads(json.dumps(TINY))
+    data["train"].update(total_steps=128, eval={"episodes": 1, "every": 32, "keep_best": True})
+    settings = TrainSettings.model_validate(data)
+    rates = iter([0.2, 0.6, 0.4, 0.6, 0.9])
+    run = tmp_path / "run"
+    train(cfg, settings, run, robot=small_robot(8), evaluate=lambda: next(rates))
+    best = read_run(run)["best"]
+    # evaluations at steps 32, 64, 96 (between rollouts): 0.2, 0.6, 0.4 -> step 64
+    assert best == {"step": 64, "success_rate": 0.6, "path": "best"}
+    assert (run / "best" / "vecnormalize.pkl").is_file() and (run / "best" / "policy.npz").is_file()
+    kept = PPO.load(run / "best" / "model.zip", device="cpu").policy.state_dict()
+    same = PPO.load(run / "checkpoints" / "step_64" / "model.zip", device="cpu").policy.state_dict()
+    assert all(bool((kept[k] == same[k]).all()) for k in kept)
+    # resumed from 128: an equal rate (0.6 at 160) does not replace it, a higher one (0.9 at
+    # 192) does
+    longer = settings.model_copy(update={"train": settings.train.model_copy(
+        update={"total_steps": 224})})
+    train(cfg, longer, run, resume=True, robot=small_robot(8), evaluate=lambda: next(rates))
+    assert read_run(run)["best"] == {"step": 192, "success_rate": 0.9, "path": "best"}
+    staged_cfg = small_cfg(
+        "task.obstacles={type: random, static: 0, dynamic: 1}",
+        "task.modules=[{type: staged, curriculum: default}]")
+    with pytest.raises(ConfigError, match="keep_best"):
+        train(staged_cfg, settings, tmp_path / "staged", robot=small_robot(8),
+              evaluate=lambda: 0.5)
