@@ -49,7 +49,7 @@ from arena.sim.state import SimState
 from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.robot_modes.random import sample_start_goal
-from arena.tasks.world import WorldSampler, wall_distance_map
+from arena.tasks.world import WorldSampler
 
 FloatArray = NDArray[np.float64]
 
@@ -220,7 +220,6 @@ class EpisodeDriver:
         self.robot_steps = np.zeros(r, dtype=np.int64)
         self._episode_index = -1
         self._respawns = 0
-        self._wall: FloatArray | None = None  # the episode's wall distance (respawns)
         self.scans = np.zeros((r, self.env_cfg.observation.laser_stack, self.obs_builder.beams))
         self.last_action = np.zeros((r, 3))
         self.goals = np.zeros((r, 3))
@@ -263,7 +262,6 @@ class EpisodeDriver:
         self.robot_steps = np.zeros(self.n_robots, dtype=np.int64)
         self._episode_index = idx
         self._respawns = 0
-        self._wall = None
         self.goals = np.array([s.goal.as_array() for s in ep.robots])
         self.last_action[:] = 0.0
         self.active[:] = True
@@ -611,9 +609,7 @@ class EpisodeDriver:
         if self.n_robots < 2:
             raise ValueError("respawn() is for multi-robot worlds; one robot starts a new episode")
         ep = self.episode
-        if self._wall is None:
-            self._wall = wall_distance_map(ep.grid)
-        world = WorldSampler(ep.grid, ep.obstacles, wall_distance=self._wall)
+        world = WorldSampler(ep.grid, ep.obstacles)  # the map's wall distance is memoised
         poses = self.state.robots.poses
         for j in range(self.n_robots):
             if j != i:

@@ -726,20 +726,19 @@ def train(
                 evaluator.model, evaluator.train_env = model, venv
                 evaluate = evaluator
             judge = evaluate
-            best = manifest.get("best") or {}
 
             def keep_best() -> None:
                 rate = float(judge())
                 t.last_success = rate
-                if rate <= float(best.get("success_rate", -1.0)):
+                if rate <= float((manifest.get("best") or {}).get("success_rate", -1.0)):
                     return
-                steps = int(model.num_timesteps)
                 (run / BEST).mkdir(parents=True, exist_ok=True)
                 model.save(run / BEST / "model.zip")
                 venv.save(str(run / BEST / "vecnormalize.pkl"))
                 export(run / BEST / "policy.npz")
-                best.update(step=steps, success_rate=rate, path=BEST)
-                manifest["best"] = dict(best)
+                manifest["best"] = {
+                    "step": int(model.num_timesteps), "success_rate": rate, "path": BEST,
+                }
                 _write_json(manifest_path, manifest)
 
             t.keep_best = keep_best

@@ -145,9 +145,16 @@ def _accept(candidates: FloatArray, chosen: FloatArray, count: int, min_gap: flo
 def wall_distance_map(grid: OccupancyGrid) -> FloatArray:
     """``(H, W)`` distance (m) between each cell centre and the nearest non-free cell centre.
 
-    Unknown cells and the space outside the map count as walls.
+    Unknown cells and the space outside the map count as walls. Computed once per map (the
+    generator, every episode's sampler and multi-robot respawns share it): read-only.
     """
-    return np.sqrt(squared_edt(~grid.free)) * grid.resolution
+
+    def compute() -> FloatArray:
+        d = np.sqrt(squared_edt(~grid.free)) * grid.resolution
+        d.setflags(write=False)
+        return d
+
+    return grid_memo(grid, "wall distance", compute)
 
 
 class WorldSampler:

@@ -155,3 +155,17 @@ def test_candidate_regions_are_reused_and_follow_the_mask():
     assert changed is not first
     assert not changed.cells(r, c).size
     assert np.array_equal(first.cells(r, c), np.argwhere(labels == labels[r, c]))
+
+
+def test_wall_distance_map_is_computed_once_per_map_and_read_only():
+    from arena.tasks.world import wall_distance_map
+
+    occ = np.zeros((20, 30), dtype=bool)
+    occ[5:8, 10:12] = True
+    grid = OccupancyGrid.from_occupied(occ, 0.1)
+    d = wall_distance_map(grid)
+    assert wall_distance_map(grid) is d and not d.flags.writeable
+    assert d[6, 10] == 0.0 and d[0, 0] == pytest.approx(0.1)  # the map's edge counts as wall
+    other = OccupancyGrid.from_occupied(occ, 0.1)  # an equal map is another object
+    assert wall_distance_map(other) is not d
+    np.testing.assert_array_equal(wall_distance_map(other), d)
