@@ -10,8 +10,12 @@ resets included (an episode ends on arrival, contact, the 60 s timeout or 500 st
 * ``single``: one :class:`~arena.learn.env.SocialNavEnv` (native2d, the full crowd with social
   states, the reference simulator), one core.
 * ``batched N``: :class:`~arena.learn.batched.BatchedSocialNavEnv` with ``N`` worlds stepped
-  together (batched lidar/contacts/social-force kernels), ``--threads`` numba threads; the
-  figure is the sum over worlds (N env steps per call).
+  together (batched lidar/contacts/social-force kernels), ``--threads`` numba threads, the next
+  episode of each world drawn ahead by one helper process (``--prefetch 1``, as training does;
+  ``--prefetch 0`` draws in-process); the figure is the sum over worlds (N env steps per call).
+
+Each setup is measured ``--repeat`` times (default 3) and the median printed, with the range:
+on a shared 2-core host the same code varies by a third from one minute to the next.
 
 Targets (issue 7, 2 cores): >= 3,000 steps/s single, >= 20,000 steps/s batched (16 and 64).
 """
@@ -59,19 +63,30 @@ def single(steps: int) -> float:
     return steps / (time.perf_counter() - t0)
 
 
-def batched(n: int, steps: int) -> float:
+def batched(n: int, steps: int, prefetch: int, repeat: int) -> list[float]:
+    """``repeat`` measurements of ``steps`` env steps each, one after the other on one env."""
     from arena.learn.batched import BatchedSocialNavEnv
 
-    env = BatchedSocialNavEnv(None, OVERRIDES, num_envs=n)
-    env.reset(seed=0)
-    env.action_space.seed(0)
-    for _ in range(20):
-        env.step(env.action_space.sample())
-    calls = max(1, steps // n)
-    t0 = time.perf_counter()
-    for _ in range(calls):
-        env.step(env.action_space.sample())
-    return calls * n / (time.perf_counter() - t0)
+    env = BatchedSocialNavEnv(None, OVERRIDES, num_envs=n, prefetch=prefetch)
+    try:
+        env.reset(seed=0)
+        env.action_space.seed(0)
+        # The helper's start-up (imports, cached kernels: a few seconds) is not drawing time;
+        # a training run lasts hours. Warm-up steps then compile this process's kernels.
+        if not env.wait_prefetch(timeout=300.0):
+            print("warning: the prefetch helper did not deliver within 300 s", file=sys.stderr)
+        for _ in range(20):
+            env.step(env.action_space.sample())
+        calls = max(1, steps // n)
+        rates = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            for _ in range(calls):
+                env.step(env.action_space.sample())
+            rates.append(calls * n / (time.perf_counter() - t0))
+        return rates
+    finally:
+        env.close()
 
 
 def main() -> None:
@@ -80,20 +95,30 @@ def main() -> None:
                     help="env steps per measurement (resets included: ~40 episodes single)")
     ap.add_argument("--worlds", type=int, nargs="+", default=[16, 64])
     ap.add_argument("--threads", type=int, default=2, help="numba threads (batched)")
+    ap.add_argument("--repeat", type=int, default=3,
+                    help="measurements per setup; the median is the figure (shared hosts vary)")
     ap.add_argument("--skip-single", action="store_true")
+    ap.add_argument("--prefetch", type=int, default=1,
+                    help="batched: episodes per world drawn ahead by a helper process "
+                    "(learning.train.prefetch_episodes; 0: drawn in-process)")
     args = ap.parse_args()
     import numba
 
+    def show(label: str, rates: list[float], target: str) -> None:
+        spread = ""
+        if len(rates) > 1:
+            spread = f"  ({min(rates):,.0f}-{max(rates):,.0f} over {len(rates)})"
+        print(f"{label:<46s} {float(np.median(rates)):8,.0f} steps/s{spread}  (target {target})")
+
     if not args.skip_single:
         numba.set_num_threads(1)
-        rate = single(args.steps)
-        print(f"single SocialNavEnv (native2d, 1 core):        {rate:8.0f} steps/s  "
-              f"(target 3,000)")
+        rates = [single(args.steps) for _ in range(args.repeat)]
+        show("single SocialNavEnv (native2d, 1 core):", rates, "3,000")
     numba.set_num_threads(min(args.threads, numba.config.NUMBA_NUM_THREADS))
     for n in args.worlds:
-        rate = batched(n, max(args.steps, 20 * n))
-        print(f"BatchedSocialNavEnv N={n:<3d} ({numba.get_num_threads()} threads):     "
-              f"{rate:8.0f} steps/s  (target 20,000)")
+        rates = batched(n, max(args.steps, 20 * n), args.prefetch, args.repeat)
+        show(f"BatchedSocialNavEnv N={n} ({numba.get_num_threads()} threads, prefetch "
+             f"{args.prefetch}):", rates, "20,000")
     sys.stdout.flush()
 
 

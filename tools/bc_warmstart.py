@@ -250,7 +250,8 @@ def main() -> None:
         return expert(raw, low, high, args.max_speed or 1.0, args.slow_distance)
 
     venv = make_vec_env(cfg, tr.n_envs, tr.vec_env, seed=int(run["seed"]) + 7919,
-                        robots_per_world=tr.robots_per_world, respawn=tr.respawn)
+                        robots_per_world=tr.robots_per_world, respawn=tr.respawn,
+                        prefetch=tr.prefetch_episodes)
     venv = VecNormalize.load(str(ckpt / "vecnormalize.pkl"), venv)
     venv.training = True
     model = PPO.load(ckpt / "model.zip", env=venv, device="cpu")

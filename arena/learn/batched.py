@@ -35,7 +35,10 @@ Info (arrays over worlds, each key ``k`` with its mask ``_k``, gymnasium's vecto
 
 from __future__ import annotations
 
+import os
+import warnings
 from collections.abc import Sequence
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -43,6 +46,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
+from arena.config.schema import ExperimentConfig
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome
 from arena.learn.actions import ActionDecoder
@@ -54,6 +58,7 @@ from arena.learn.driver import (
     substeps,
 )
 from arena.learn.observations import Obs, ObservationBuilder, ObsInput
+from arena.learn.prefetch import EpisodePrefetcher
 from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
@@ -79,6 +84,11 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         robot: a robot model replacing ``cfg.robot``.
         sim_params: parameters of the batched simulator.
         autoreset_mode: ``NEXT_STEP`` (default) or ``SAME_STEP``.
+        prefetch: episodes per world drawn ahead by a helper process
+            (:class:`~arena.learn.prefetch.EpisodePrefetcher`); 0 (default) draws them in this
+            process when a world restarts. The episodes, and so every result, are the same
+            either way; prefetching overlaps the drawing with the simulation (one more process;
+            :meth:`close` stops it).
     """
 
     metadata = {  # noqa: RUF012  (gymnasium declares it an instance attribute)
@@ -95,6 +105,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         robot: RobotModel | None = None,
         sim_params: BatchSim.Params | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        prefetch: int = 0,
     ) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
@@ -151,21 +162,32 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         )
         self._subgoals = np.zeros((n, 2))
         self._stage: int | None = None
+        if prefetch < 0:
+            raise ValueError(f"prefetch must be >= 0 episodes per world, got {prefetch}")
+        if prefetch and os.name == "nt":
+            warnings.warn(
+                "episode prefetching needs a POSIX system (it passes pipes to a helper process); "
+                "drawing episodes in this process instead", RuntimeWarning, stacklevel=2,
+            )
+            prefetch = 0
+        self.prefetch = int(prefetch)
+        self._prefetcher: EpisodePrefetcher | None = None
+        if self.prefetch:
+            self._prefetcher = EpisodePrefetcher(
+                partial(make_generator, self.cfg), self.robot, self.seed_value, None
+            )
 
     # -- episodes ----------------------------------------------------------------------------------
     def _generator(self, seed: int) -> TaskGenerator:
-        cfg = self.cfg.model_copy(update={"seed": int(seed)})
-        gen: TaskGenerator = TaskGenerator.from_config(cfg, [self.robot])
-        stage = getattr(self, "_stage", None)
-        if stage is not None:
-            for m in _staged_modules(gen):
-                m.set_stage(stage)
-        return gen
+        return make_generator(self.cfg, self.robot, seed, getattr(self, "_stage", None))
 
     def set_stage(self, index: int) -> int:
         """Move every ``staged`` task module to ``index`` (clamped); return the stage."""
         self._stage = int(index)
         stages = [m.set_stage(index) for m in _staged_modules(self.generator)]
+        if self._prefetcher is not None:
+            self._prefetcher.restart(self.seed_value, self._stage)
+            self._request_next(self._arange)
         return stages[0] if stages else -1
 
     def get_stage(self) -> int:
@@ -177,10 +199,13 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         """The next episode (and simulator stream) of each world in ``worlds``."""
         eps: list[Episode] = []
         rngs: list[np.random.Generator] = []
+        pre = self._prefetcher
         for i in worlds:
             idx = i + int(self._k[i]) * self.num_envs
             self._k[i] += 1
-            ep = self.generator.episode(idx)
+            ep = pre.take(idx) if pre is not None else None
+            if ep is None:  # no prefetcher, or it failed: draw here (raises the real error)
+                ep = self.generator.episode(idx)
             eps.append(ep)
             rngs.append(derive_rng(self.seed_value, "episode", idx, "sim"))
             self._ep_index[i] = idx
@@ -188,7 +213,19 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             self._goals[i] = ep.robots[0].goal.as_array()[:2]
             self._goal_radius[i] = ep.goal_radius
             self._time_limit[i] = ep.time_limit
+        if pre is not None:
+            self._request_next(worlds)
         return eps, rngs
+
+    def _request_next(self, worlds: Sequence[int] | NDArray[np.int64]) -> None:
+        """Ask the prefetcher for the next ``prefetch`` episodes of each world in ``worlds``."""
+        pre = self._prefetcher
+        if pre is None:
+            return
+        n = self.num_envs
+        pre.request(
+            int(i) + (int(self._k[i]) + a) * n for a in range(self.prefetch) for i in worlds
+        )
 
     def _restart(self, worlds: NDArray[np.int64], state: BatchState) -> None:
         """Bookkeeping of freshly reset worlds (state: the snapshot after their reset)."""
@@ -232,6 +269,8 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
                 self.seed_value = int(seed)
                 self.generator = self._generator(self.seed_value)
             self._k[:] = 0
+            if self._prefetcher is not None:
+                self._prefetcher.restart(self.seed_value, self._stage)
         mask = (options or {}).get("reset_mask")
         if mask is not None and self._state is not None and seed is None:
             worlds = np.flatnonzero(np.asarray(mask, dtype=bool))
@@ -251,6 +290,8 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         """Hold each world's action for one action period (autoreset as the mode says)."""
         if self._state is None:
             raise RuntimeError("call reset() before step()")
+        if self._prefetcher is not None:
+            self._prefetcher.pump()
         n = self.num_envs
         cmd = self.decoder.decode(actions)
         if cmd.shape[0] != n:
@@ -417,8 +458,37 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             info["_collision"] = ones.copy()
         return info
 
+    def wait_prefetch(self, timeout: float = 120.0) -> bool:
+        """Block until the prefetch helper holds every episode asked of it; ``False`` on timeout.
+
+        Never needed for correctness (a world whose next episode has not arrived draws it
+        itself); benchmarks call it so that the helper's start-up (a few seconds of imports)
+        is not timed. ``True`` at once without a helper.
+        """
+        return self._prefetcher.wait(timeout) if self._prefetcher is not None else True
+
     def close_extras(self, **kwargs: Any) -> None:
-        """Nothing to release (no subprocesses)."""
+        """Stop the prefetch process, if any."""
+        if self._prefetcher is not None:
+            self._prefetcher.close()
+            self._prefetcher = None
+
+
+def make_generator(
+    cfg: ExperimentConfig, robot: RobotModel, seed: int, stage: int | None
+) -> TaskGenerator:
+    """The task generator of ``cfg`` placing ``robot``, with ``seed`` and curriculum ``stage``.
+
+    Module-level (picklable with ``functools.partial``) so the prefetch process builds the
+    very generator the env builds.
+    """
+    gen: TaskGenerator = TaskGenerator.from_config(
+        cfg.model_copy(update={"seed": int(seed)}), [robot]
+    )
+    if stage is not None:
+        for m in _staged_modules(gen):
+            m.set_stage(stage)
+    return gen
 
 
 def _staged_modules(gen: TaskGenerator) -> list[Any]:
@@ -456,7 +526,8 @@ if HAVE_SB3:
         next ``reset()``.
 
         Args:
-            config, overrides, num_envs, robot, sim_params: as :class:`BatchedSocialNavEnv`.
+            config, overrides, num_envs, robot, sim_params, prefetch: as
+                :class:`BatchedSocialNavEnv`.
         """
 
         def __init__(
@@ -467,10 +538,11 @@ if HAVE_SB3:
             num_envs: int = 1,
             robot: RobotModel | None = None,
             sim_params: BatchSim.Params | None = None,
+            prefetch: int = 0,
         ) -> None:
             self.env = BatchedSocialNavEnv(
                 config, overrides, num_envs=num_envs, robot=robot, sim_params=sim_params,
-                autoreset_mode=AutoresetMode.SAME_STEP,
+                autoreset_mode=AutoresetMode.SAME_STEP, prefetch=prefetch,
             )
             super().__init__(
                 num_envs, self.env.single_observation_space, self.env.single_action_space

@@ -243,12 +243,14 @@ def make_vec_env(
     seed: int | None = None,
     robots_per_world: Sequence[int] | None = None,
     respawn: bool = False,
+    prefetch: int = 0,
 ) -> Any:
     """``n_envs`` environments in SB3's ``DummyVecEnv`` or ``SubprocVecEnv``.
 
     ``kind="batched"``: one :class:`~arena.learn.batched.SB3VecEnv` over a
     :class:`~arena.learn.batched.BatchedSocialNavEnv` of ``n_envs`` worlds (seeded with
-    ``seed`` at its next reset when given). ``kind="multi_robot"``: a
+    ``seed`` at its next reset when given; ``prefetch`` episodes per world drawn ahead in a
+    helper process). ``kind="multi_robot"``: a
     :class:`~arena.learn.multi_vec.MultiRobotVecEnv` with ``robots_per_world`` (summing to
     ``n_envs``; default: one world of ``n_envs`` robots) and ``respawn``.
     """
@@ -269,7 +271,7 @@ def make_vec_env(
     if kind == "batched":
         from arena.learn.batched import SB3VecEnv
 
-        venv = SB3VecEnv(cfg, num_envs=n_envs, robot=robot)
+        venv = SB3VecEnv(cfg, num_envs=n_envs, robot=robot, prefetch=prefetch)
         if seed is not None:
             venv.seed(int(seed))
         return venv
@@ -624,7 +626,8 @@ def train(
         staged.set_stage(int(manifest["stage"]))
 
     venv = make_vec_env(cfg, tr.n_envs, tr.vec_env, robot, seed=seed,
-                        robots_per_world=tr.robots_per_world, respawn=tr.respawn)
+                        robots_per_world=tr.robots_per_world, respawn=tr.respawn,
+                        prefetch=tr.prefetch_episodes)
     nc = ppo.normalize
     try:
         if resume:

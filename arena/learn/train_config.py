@@ -194,6 +194,12 @@ class TrainConfig(_Strict):
         "new start and goal in its running world (Long et al.); false: the first robot to "
         "finish ends its world's episode for all",
     )
+    prefetch_episodes: int = Field(
+        1,
+        ge=0,
+        description="batched: episodes per world drawn ahead by a helper process, overlapping "
+        "the simulation (same episodes either way); 0: drawn in the training process",
+    )
     seed: int | None = Field(None, ge=0, description="run seed; null: the experiment's seed")
     checkpoint_every: int = Field(100_000, ge=1, description="env steps between checkpoints")
     tensorboard: bool = Field(True, description="write TensorBoard logs to RUN/tb")
