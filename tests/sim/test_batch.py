@@ -167,6 +167,40 @@ def test_reset_world_touches_only_that_world(episodes: list[Episode]) -> None:
     np.testing.assert_array_equal(after.scans[1], ref.scans[0])
 
 
+def test_worlds_with_other_kinematics_regroup_on_model_change(episodes: list[Episode]) -> None:
+    # World 1 gets an omnidirectional copy of the jackal (same lidar): a lateral command moves
+    # it sideways but not the diff-drive worlds; a reset with the jackal again undoes that.
+    from dataclasses import replace
+
+    jackal = episodes[0].robots[0].model
+    omni = load_robot("ridgeback").model_copy(update={"laser": jackal.laser})
+    assert omni.holonomic and not jackal.holonomic
+
+    def with_model(ep: Episode, model: object) -> Episode:
+        robot = replace(ep.robots[0], model=model)
+        return replace(ep, robots=(robot,))
+
+    sim = BatchSim(3, BatchSim.Params(pedestrians="static", collision_response="record"))
+    start = sim.reset([episodes[0], with_model(episodes[1], omni), episodes[2]],
+                      np.random.default_rng(0))
+    assert len(sim._groups) == 2
+    lateral = np.tile([0.0, 0.5, 0.0], (3, 1))
+    moved = sim.step(lateral, 0.1)
+    body = moved.poses[:, :2] - start.poses[:, :2]
+    heading = start.poses[:, 2]
+    sideways = -np.sin(heading) * body[:, 0] + np.cos(heading) * body[:, 1]
+    assert sideways[1] > 0.01
+    np.testing.assert_allclose(sideways[[0, 2]], 0.0, atol=1e-12)
+    # the same model again: nothing rebuilt; the jackal back in world 1: one group again
+    kin = sim._kin[0]
+    sim.reset_world(0, episodes[3], np.random.default_rng(1))
+    assert sim._kin[0] is kin and len(sim._groups) == 2
+    back = sim.reset_world(1, episodes[1], np.random.default_rng(2))
+    assert len(sim._groups) == 1
+    again = sim.step(lateral, 0.1)
+    assert np.all(np.hypot(*(again.poses[:, :2] - back.poses[:, :2]).T) < 1e-12)
+
+
 def test_reset_world_with_another_map_keeps_shared_map(episodes: list[Episode]) -> None:
     from arena.core.types import Pose2D
     from arena.tasks.episode import AgentSpawn, RobotSpawn

@@ -52,6 +52,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from arena.core.errors import SimulationError
 from arena.maps.grid import OccupancyGrid
 from arena.robots.kinematics.base import Kinematics, KinematicState
+from arena.robots.model import RobotModel
 from arena.sensors.lidar2d import _add_noise, use_wall_faces, wall_faces
 from arena.sensors.spec import LidarSpec
 from arena.sim.backend import split_rng
@@ -195,6 +196,7 @@ class BatchSim:
         self._spec: LidarSpec | None = None
         self._episodes: list[Episode | None] = [None] * n
         self._kin: list[Kinematics | None] = [None] * n
+        self._models: list[RobotModel | None] = [None] * n  # whose kinematics _kin[i] holds
         self._crowd_rng: list[np.random.Generator | None] = [None] * n
         self._sensor_rng: list[np.random.Generator | None] = [None] * n
         self._world_rng: list[np.random.Generator | None] = [None] * n
@@ -558,22 +560,27 @@ class BatchSim:
         if len(ep.robots) != 1:
             raise SimulationError(f"BatchSim worlds hold one robot, episode has {len(ep.robots)}")
         robot = ep.robots[0]
-        spec = robot.model.laser
+        model = robot.model
+        spec = model.laser
         if self._spec is None:
             self._set_spec(spec)
-        elif spec != self._spec:
+        elif spec is not self._spec and spec != self._spec:
             raise SimulationError("every world's robot must carry the same lidar spec")
         self._episodes[i] = ep
         self._world_rng[i] = rng
         self._crowd_rng[i], self._sensor_rng[i] = split_rng(rng)
-        self._kin[i] = robot.model.build_kinematics()
-        self._regroup()
+        # A task generator hands every episode the same model object: build its kinematics and
+        # regroup the worlds only when world i gets another model (models are frozen).
+        if model is not self._models[i]:
+            self._models[i] = model
+            self._kin[i] = model.build_kinematics()
+            self._radius[i] = self.params.robot_radius or model.circumscribed_radius
+            self._regroup()
         # robot
         self._poses[i] = robot.start.as_array()
         self._twists[i] = 0.0
         self._steer[i] = 0.0
         self._commands[i] = 0.0
-        self._radius[i] = self.params.robot_radius or robot.model.circumscribed_radius
         self._time[i] = 0.0
         self._step[i] = 0
         self._last_scan[i] = -math.inf
@@ -598,8 +605,11 @@ class BatchSim:
         for j, ob in enumerate(ep.obstacles):
             poly = ob.polygon
             m = len(poly)
+            if m == 0:
+                continue
             self._seg_a[i, s : s + m] = poly
-            self._seg_b[i, s : s + m] = np.roll(poly, -1, axis=0)
+            self._seg_b[i, s : s + m - 1] = poly[1:]  # np.roll(poly, -1, axis=0), unallocated
+            self._seg_b[i, s + m - 1] = poly[0]
             self._seg_owner[i, s : s + m] = j
             s += m
         self._seg_n[i] = s
