@@ -280,3 +280,62 @@ def test_worlds_mix_wall_faces_and_grid_walk() -> None:
         for i, g in enumerate(grids):
             lidar.bind(g)
             np.testing.assert_array_equal(s.scans[i], lidar.scan(s.poses[i]))
+
+
+def test_obstacle_edge_forces_match_the_formula_near_and_far() -> None:
+    # Four 1 m boxes in a 20 m room; one pedestrian per box: beside an edge (in reach), off a
+    # corner (outside the box's extent on both axes, but in reach), beyond the cutoff, and below
+    # an edge. The first step's velocity is the goal term plus every edge within the cutoff
+    # (the kernel skips edge runs whose bounding box is out of reach; this catches one skipped
+    # wrongly). Walls, the robot and the other pedestrians are out of reach.
+    from arena.core.types import Pose2D
+    from arena.sim.batch import kernels as K
+    from arena.sim.state import Obstacle
+    from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn, RobotSpawn
+
+    grid = OccupancyGrid.from_occupied(np.pad(np.zeros((396, 396), bool), 2, constant_values=True),
+                                       0.05)
+    square = np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+    centres = [(5.0, 5.0), (14.0, 5.0), (5.0, 14.0), (14.0, 14.0)]
+    obstacles = tuple(
+        Obstacle(f"box{k}", "cuboid", np.array([x, y, 0.0]), square)
+        for k, (x, y) in enumerate(centres)
+    )
+    peds = np.array([[5.0, 6.2], [16.0, 7.0], [9.5, 14.0], [14.0, 12.8]])
+    n = len(peds)
+    wps = np.full((n, 1, 2), np.nan)
+    wps[:, 0] = peds + np.array([2.0, 0.0])
+    agents = AgentSpawn(
+        positions=peds, radii=np.full(n, 0.3), vmax=np.full(n, 1.2), waypoints=wps,
+        num_waypoints=np.ones(n, np.int64), waypoint_mode=np.full(n, WAYPOINT_LOOP),
+        kinds=np.zeros(n, np.int64),
+    )
+    robot = RobotSpawn("r", load_robot("jackal"), Pose2D(10.0, 2.5, 0.0), Pose2D(12.0, 2.5, 0.0))
+    ep = Episode(0, 0, "room", grid, obstacles, (robot,), agents, 10.0)
+    sim = BatchSim(1)
+    sim.reset([ep], np.random.default_rng(0))
+    dt = 0.1
+    st = sim.step(np.zeros((1, 3)), dt)
+
+    prm = sim._crowd_prm
+    tau, a_w, b_w = prm[K.P_TAU], prm[K.P_A_WALL], prm[K.P_B_WALL]
+    cutoff, cap = prm[K.P_CUTOFF], prm[K.P_VFAC] * 1.2
+    edges = [(o.polygon[k], o.polygon[(k + 1) % 4]) for o in obstacles for k in range(4)]
+    expected = np.zeros((n, 2))
+    pushed = np.zeros(n)
+    for a, p in enumerate(peds):
+        acc = 1.2 * np.array([1.0, 0.0]) / tau  # toward the waypoint 2 m ahead, from rest
+        for q, b in edges:
+            e = b - q
+            t = np.clip(np.dot(p - q, e) / np.dot(e, e), 0.0, 1.0)
+            off = p - q - t * e
+            d = np.hypot(*off)
+            if d < cutoff:
+                acc = acc + a_w * np.exp((0.3 - d) / b_w) * off / d
+                pushed[a] += 1
+        v = acc * dt
+        speed = np.hypot(*v)
+        expected[a] = v * (cap / speed) if speed > cap else v
+    assert pushed.tolist() == [4, 4, 0, 4]  # edges in reach of each pedestrian
+    np.testing.assert_allclose(st.ped_velocities[0, :n], expected, rtol=1e-9, atol=1e-12)
+    assert st.ped_velocities[0, 2, 1] == 0.0  # beyond the cutoff: no push at all

@@ -39,6 +39,8 @@ I64 = NDArray[np.int64]
 B1 = NDArray[np.bool_]
 
 SQRT2 = math.sqrt(2.0)
+#: Obstacle edges per bounding box in the crowd kernel's culling (a rectangle's four).
+_EDGE_RUN = 4
 _NO_OWNER = np.zeros(0, dtype=np.int64)
 
 #: Collision kinds reported per world (the first that applies, in this order).
@@ -420,6 +422,24 @@ def _crowd_worlds_one(
     rs = res[w]
     gx0, gy0 = origin[w, 0], origin[w, 1]
     s_n = seg_n[w]
+    # Obstacle edges in runs of _EDGE_RUN (a box's four edges) with their bounding boxes: a
+    # pedestrian farther than the cutoff from a run's box is farther from each of its edges,
+    # whose forces are zero then, so the run is skipped. The 1e-9 m margin keeps the test
+    # conservative under rounding: every edge that can act is still visited, in order, so the
+    # sum is bit-identical; most pedestrians are far from most obstacles.
+    n_run = (s_n + _EDGE_RUN - 1) // _EDGE_RUN
+    run_box = np.empty((n_run, 4))
+    for r in range(n_run):
+        bx0 = by0 = math.inf
+        bx1 = by1 = -math.inf
+        for s in range(r * _EDGE_RUN, min((r + 1) * _EDGE_RUN, s_n)):
+            for px, py in ((seg_a[w, s, 0], seg_a[w, s, 1]), (seg_b[w, s, 0], seg_b[w, s, 1])):
+                bx0 = min(bx0, px)
+                by0 = min(by0, py)
+                bx1 = max(bx1, px)
+                by1 = max(by1, py)
+        run_box[r, 0], run_box[r, 1], run_box[r, 2], run_box[r, 3] = bx0, by0, bx1, by1
+    far2 = (cutoff + 1e-9) * (cutoff + 1e-9)
     # Pair distances and repulsion magnitudes, once per unordered pair: both are symmetric bit
     # for bit (x_b - x_a is exactly -(x_a - x_b), hypot ignores signs, r_a + r_b = r_b + r_a),
     # so pedestrian a reads the very values it used to compute, at half the hypot/exp calls.
@@ -491,21 +511,26 @@ def _crowd_worlds_one(
             f = a_w * math.exp((ra - dw) / b_w)
             ax += f * nx
             ay += f * ny
-        # -- obstacle edges --
-        for s in range(s_n):
-            qx, qy = seg_a[w, s, 0], seg_a[w, s, 1]
-            ex = seg_b[w, s, 0] - qx
-            ey = seg_b[w, s, 1] - qy
-            ee = ex * ex + ey * ey
-            t = ((x - qx) * ex + (y - qy) * ey) / ee if ee > 0.0 else 0.0
-            t = min(max(t, 0.0), 1.0)
-            dx = x - qx - t * ex
-            dy = y - qy - t * ey
-            d = math.hypot(dx, dy)
-            if 1e-9 < d < cutoff:
-                f = a_w * math.exp((ra - d) / b_w)
-                ax += f * dx / d
-                ay += f * dy / d
+        # -- obstacle edges (runs whose box is out of reach skipped, see above) --
+        for r in range(n_run):
+            ox = max(run_box[r, 0] - x, 0.0, x - run_box[r, 2])
+            oy = max(run_box[r, 1] - y, 0.0, y - run_box[r, 3])
+            if ox * ox + oy * oy >= far2:
+                continue
+            for s in range(r * _EDGE_RUN, min((r + 1) * _EDGE_RUN, s_n)):
+                qx, qy = seg_a[w, s, 0], seg_a[w, s, 1]
+                ex = seg_b[w, s, 0] - qx
+                ey = seg_b[w, s, 1] - qy
+                ee = ex * ex + ey * ey
+                t = ((x - qx) * ex + (y - qy) * ey) / ee if ee > 0.0 else 0.0
+                t = min(max(t, 0.0), 1.0)
+                dx = x - qx - t * ex
+                dy = y - qy - t * ey
+                d = math.hypot(dx, dy)
+                if 1e-9 < d < cutoff:
+                    f = a_w * math.exp((ra - d) / b_w)
+                    ax += f * dx / d
+                    ay += f * dy / d
         # -- integrate --
         nvx = vx + ax * dt
         nvy = vy + ay * dt
