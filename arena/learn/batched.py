@@ -308,11 +308,11 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         prev_pose = prev.poses
         d = self._goals - prev_pose[:, :2]
         prev_dist = np.hypot(d[:, 0], d[:, 1])
-        collision = np.zeros(n, dtype=bool)
-        state = prev
-        for _ in range(self.substeps):
+        state = self.sim.step(cmd, self.dt)
+        collision = state.collided  # a fresh array of the snapshot
+        for _ in range(self.substeps - 1):
             state = self.sim.step(cmd, self.dt)
-            collision |= state.collided
+            collision = collision | state.collided
         self._steps += 1
         scans = state.scans
         if self._scans.shape[1] > 1:

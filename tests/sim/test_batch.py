@@ -339,3 +339,24 @@ def test_obstacle_edge_forces_match_the_formula_near_and_far() -> None:
     assert pushed.tolist() == [4, 4, 0, 4]  # edges in reach of each pedestrian
     np.testing.assert_allclose(st.ped_velocities[0, :n], expected, rtol=1e-9, atol=1e-12)
     assert st.ped_velocities[0, 2, 1] == 0.0  # beyond the cutoff: no push at all
+
+
+def test_pedestrian_mask_follows_reloaded_worlds(episodes: list[Episode]) -> None:
+    from dataclasses import replace
+
+    from arena.tasks.episode import AgentSpawn
+
+    sim = BatchSim(2)
+    st = sim.reset(episodes[:2], np.random.default_rng(0))
+    n = len(episodes[0].agents)
+    assert st.ped_mask[:, :n].all() and not st.ped_mask[:, n:].any()
+    assert (st.ped_states[st.ped_mask] == 0).all() and (st.ped_states[~st.ped_mask] == -1).all()
+    with pytest.raises(ValueError):
+        st.ped_mask[0, 0] = False  # shared by snapshots: read-only
+    empty = replace(episodes[2], agents=AgentSpawn.empty())
+    after = sim.reset_world(1, empty, np.random.default_rng(1))
+    assert after.ped_mask[0, :n].all() and not after.ped_mask[1].any()
+    assert (after.ped_states[1] == -1).all()
+    assert st.ped_mask[1, :n].all()  # the earlier snapshot is unchanged
+    stepped = sim.step(np.zeros((2, 3)), 0.1)
+    np.testing.assert_array_equal(stepped.ped_mask, after.ped_mask)

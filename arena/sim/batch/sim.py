@@ -238,7 +238,8 @@ class BatchSim:
         self._alloc_peds(0, 1)
         self._rand = np.zeros((n, _RAND_TABLE))
         self._rand_k = np.zeros(n, dtype=np.int64)
-        self._slots = np.arange(0)  # pedestrian slot indices (_snapshot's mask)
+        # (ped_mask, ped_states) of the snapshots, read-only; None: rebuild (after a load)
+        self._ped_view: tuple[NDArray[np.bool_], I64] | None = None
         self._all = np.ones(n, dtype=bool)  # the crowd kernels' "active" flags
 
     # -- public API ------------------------------------------------------------------------------
@@ -337,7 +338,7 @@ class BatchSim:
         cmd = np.asarray(commands, dtype=np.float64)
         if cmd.shape != (n, 3):
             raise SimulationError(f"commands must have shape ({n}, 3), got {cmd.shape}")
-        if not np.all(np.isfinite(cmd)):
+        if not np.isfinite(cmd).all():
             raise SimulationError("commands must be finite")
         if not dt > 0:
             raise SimulationError(f"dt must be > 0 s, got {dt}")
@@ -516,6 +517,7 @@ class BatchSim:
         self._vmax = np.zeros((n, p))
         self._kinds = np.full((n, p), -1, dtype=np.int64)
         self._ped_n = np.zeros(n, dtype=np.int64)
+        self._ped_view = None
         self._wps = np.zeros((n, p, k, 2))
         self._n_wp = np.ones((n, p), dtype=np.int64)
         self._wp_mode = np.zeros((n, p), dtype=np.int64)
@@ -617,6 +619,7 @@ class BatchSim:
         a = ep.agents
         p = len(a)
         self._ped_n[i] = p
+        self._ped_view = None
         for arr, fill in ((self._pos, 0.0), (self._vel, 0.0), (self._heading, 0.0),
                           (self._pradii, 0.0), (self._vmax, 0.0), (self._kinds, -1),
                           (self._wps, 0.0), (self._n_wp, 1), (self._wp_mode, 0),
@@ -688,13 +691,14 @@ class BatchSim:
         kind[self._agent >= 0] = K.KIND_PEDESTRIAN
         kind[self._obstacle >= 0] = K.KIND_OBSTACLE
         kind[self._wall] = K.KIND_WALL
-        p = self._pos.shape[1]
-        slots = self._slots
-        if slots.shape[0] != p:
-            slots = self._slots = np.arange(p)
-        mask = slots[None, :] < self._ped_n[:, None]
-        states = mask.astype(np.int64)  # np.where(mask, 0, -1) as 1/0 minus 1
-        states -= 1
+        if self._ped_view is None:  # changes only when a world is loaded: built once then
+            mask = np.arange(self._pos.shape[1])[None, :] < self._ped_n[:, None]
+            states = mask.astype(np.int64)  # np.where(mask, 0, -1) as 1/0 minus 1
+            states -= 1
+            mask.setflags(write=False)  # shared by the snapshots until the next load
+            states.setflags(write=False)
+            self._ped_view = (mask, states)
+        mask, states = self._ped_view
         return BatchState(
             time=self._time.copy(), step=self._step.copy(), poses=self._poses.copy(),
             twists=self._twists.copy(), commands=self._commands.copy(),
