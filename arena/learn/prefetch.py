@@ -10,10 +10,12 @@ keeps each world's next episode ready; it runs on the cores the kernels leave id
 
 The helper runs under ``SCHED_IDLE`` (Linux; elsewhere at a lower nice level): the scheduler
 gives it a core only when no other thread wants it, so the kernels' threads, which wait for each
-other at the end of every launch, are never held up by it. Measured on 2 cores (16 worlds,
-interleaved runs): 11,735 env steps/s median without the helper, 14,255 with it at nice 10 and
-15,174 under ``SCHED_IDLE``. The helper needs a few seconds to start (imports, compiled
-kernels); until its first episodes arrive the env draws them itself.
+other at the end of every launch, are never held up by it. Measured on 2 shared cores
+(``benchmarks/env_throughput.py``'s setup, 16 worlds, rounds of both envs interleaved in one
+process): 19,115 env steps/s median without the helper against 22,603 with it (and 12,539
+against 17,086 in a slower hour); a helper at nice 10 instead gained about half as much. The
+helper needs a few seconds to start (imports, compiled kernels); until its first episodes
+arrive the env draws them itself.
 
 Results do not change: an episode is a pure function of ``(config, robot, seed, stage,
 index)`` (every draw comes from ``derive_rng(seed, "episode", index, …)``), and the helper
