@@ -41,6 +41,7 @@ import select
 import subprocess
 import sys
 import time
+import warnings
 from collections import OrderedDict, deque
 from collections.abc import Callable, Iterable
 from multiprocessing.connection import Connection
@@ -111,7 +112,9 @@ class EpisodePrefetcher:
     Use :meth:`request` for indices needed soon and :meth:`take` when one is needed now (it
     returns ``None`` for one not drawn yet: draw it yourself);
     :meth:`restart` after a seed or stage change (episodes drawn before it are discarded);
-    :meth:`close` (or garbage collection) ends the helper.
+    :meth:`close` (or garbage collection) ends the helper. If the helper dies (killed, out of
+    memory), a ``RuntimeWarning`` says so once and :meth:`take` returns ``None`` from then on:
+    the caller draws every episode itself, which changes no result.
     """
 
     def __init__(self, factory: GeneratorFactory, robot: RobotModel, seed: int,
@@ -135,6 +138,7 @@ class EpisodePrefetcher:
         self._poller = select.poll()
         self._poller.register(from_child, select.POLLIN)
         self._closed = False
+        self._lost = False  # the helper went away: every episode is drawn by the caller
         self._send(("start", factory, robot, int(seed), stage))
         self._epoch = 0
         self._grids: dict[int, OccupancyGrid] = {}
@@ -153,6 +157,8 @@ class EpisodePrefetcher:
 
     def request(self, indices: Iterable[int]) -> None:
         """Ask for episodes ``indices`` (those not ready or asked for already), in this order."""
+        if self._lost:
+            return
         new = [int(i) for i in indices
                if i not in self._ready and i not in self._pending and i not in self._failed]
         if new:
@@ -184,8 +190,13 @@ class EpisodePrefetcher:
 
     def pump(self) -> None:
         """Receive whatever the helper has sent, without waiting (keeps its pipe flowing)."""
-        while self._poller.poll(0):
+        while not self._lost and self._poller.poll(0):
             self._receive()
+
+    @property
+    def lost(self) -> bool:
+        """Whether the helper went away (killed, crashed): :meth:`take` then gives ``None``."""
+        return self._lost
 
     def wait(self, timeout: float = 120.0) -> bool:
         """Wait until every requested episode has arrived (or failed); ``False`` on timeout.
@@ -228,15 +239,19 @@ class EpisodePrefetcher:
     def _send(self, msg: tuple[Any, ...]) -> None:
         if self._closed:
             raise RuntimeError("EpisodePrefetcher used after close()")
-        self._out.send_bytes(pickle.dumps(msg, protocol=pickle.HIGHEST_PROTOCOL))
+        if self._lost:
+            return
+        try:
+            self._out.send_bytes(pickle.dumps(msg, protocol=pickle.HIGHEST_PROTOCOL))
+        except OSError:  # BrokenPipeError: the helper is gone
+            self._lose()
 
     def _receive(self) -> None:
         try:
             data = self._in.recv_bytes()
-        except EOFError as exc:
-            raise RuntimeError(
-                f"the episode prefetch process ended (exit code {self._proc.poll()})"
-            ) from exc
+        except (EOFError, OSError):
+            self._lose()
+            return
         msg = _Unpickler(io.BytesIO(data), self._grids, self.robot).load()
         kind = msg[0]
         if kind == "grid":
@@ -250,6 +265,23 @@ class EpisodePrefetcher:
                 self._ready[index] = msg[3]
             else:
                 self._failed.add(index)
+
+    def _lose(self) -> None:
+        """The helper went away: warn once and leave all drawing to the caller from now on.
+
+        An optimisation must not end a long training run: episodes drawn here are the same.
+        """
+        if self._lost:
+            return
+        self._lost = True  # episodes already received stay valid and are still handed out
+        self._pending.clear()
+        self._failed.clear()
+        warnings.warn(
+            f"the episode prefetch process ended (exit code {self._proc.poll()}); episodes "
+            "are drawn in this process from now on (the same episodes, more slowly)",
+            RuntimeWarning,
+            stacklevel=3,
+        )
 
 
 def _serve(inbox: Connection, outbox: Connection) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from functools import partial
+from typing import Any
 
 import numpy as np
 import pytest
@@ -141,3 +142,44 @@ def test_a_draw_that_fails_in_the_helper_raises_here() -> None:
             env.reset(seed=0)
     finally:
         env.close()
+
+
+def test_a_lost_helper_leaves_the_drawing_to_the_env() -> None:
+    # Killing the helper mid-run (as an out-of-memory killer would) costs a warning, not the
+    # run: the env draws the remaining episodes itself, and the rollout is unchanged.
+    import warnings
+
+    cfg = small_cfg("learning.env.max_steps=6")  # a restart every few steps
+    runs = []
+    for prefetch in (0, 1):
+        env = BatchedSocialNavEnv(cfg, robot=small_robot(), num_envs=2, prefetch=prefetch)
+        rng = np.random.default_rng(4)
+        out: list[Any] = [env.reset(seed=3)[0]]
+        if prefetch:
+            assert env.wait_prefetch(timeout=120.0)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            for k in range(40):
+                if k == 10 and env._prefetcher is not None:
+                    env._prefetcher._proc.kill()
+                    env._prefetcher._proc.wait()
+                obs, rew, _, _, info = env.step(rng.integers(env.single_action_space.n, size=2))
+                out += [obs, rew, info["episode_index"]]
+        lost = [w for w in caught if "prefetch process ended" in str(w.message)]
+        if prefetch:
+            assert env._prefetcher is not None and env._prefetcher.lost
+            assert len(lost) == 1 and lost[0].category is RuntimeWarning
+        else:
+            assert not lost
+        env.close()
+        runs.append(out)
+    assert len(runs[0]) == len(runs[1])
+    for x, y in zip(*runs, strict=True):
+        if isinstance(x, dict):
+            assert x.keys() == y.keys()
+            for key in x:
+                np.testing.assert_array_equal(x[key], y[key])
+        else:
+            np.testing.assert_array_equal(x, y)
+    first, last = runs[1][3 * 10 + 3], runs[1][-1]  # episode indices at k = 10 and at the end
+    assert (last > first).all()  # both worlds restarted after the helper died
