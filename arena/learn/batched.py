@@ -210,7 +210,9 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             idx = i + int(self._k[i]) * self.num_envs
             self._k[i] += 1
             ep = pre.take(idx) if pre is not None else None
-            if ep is None:  # no prefetcher, or it failed: draw here (raises the real error)
+            # None: no helper, not drawn yet, the helper lost, or its draw failed: draw here
+            # (the same episode; a failing draw raises its real error here)
+            if ep is None:
                 ep = self.generator.episode(idx)
             eps.append(ep)
             rngs.append(derive_rng(self.seed_value, "episode", idx, "sim"))

@@ -13,9 +13,10 @@ gives it a core only when no other thread wants it, so the kernels' threads, whi
 other at the end of every launch, are never held up by it. Measured on 2 shared cores
 (``benchmarks/env_throughput.py``'s setup, 16 worlds, rounds of both envs interleaved in one
 process): 19,115 env steps/s median without the helper against 22,603 with it (and 12,539
-against 17,086 in a slower hour); a helper at nice 10 instead gained about half as much. The
-helper needs a few seconds to start (imports, compiled kernels); until its first episodes
-arrive the env draws them itself.
+against 17,086 in a slower hour). In one comparison of all three, 11,735 without the helper
+rose to 14,255 with it at nice 10 and to 15,174 under ``SCHED_IDLE``. The helper needs a few
+seconds to start (imports, compiled kernels); until its first episodes arrive the env draws
+them itself.
 
 Results do not change: an episode is a pure function of ``(config, robot, seed, stage,
 index)`` (every draw comes from ``derive_rng(seed, "episode", index, …)``), and the helper
