@@ -7,6 +7,7 @@ with status 2; no traceback. ``ARENA_DEBUG=1`` shows the traceback anyway.
 from __future__ import annotations
 
 import os
+import re
 import sys
 from enum import StrEnum
 from pathlib import Path
@@ -26,6 +27,23 @@ app = typer.Typer(
 )
 console = Console()
 err_console = Console(stderr=True)
+
+PluginOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--plugin",
+        help="a plugin .py file or module to import first (it registers itself, e.g. a local "
+        "planner); repeatable; worker processes import it too",
+    ),
+]
+
+
+def _load_plugins(specs: list[str] | None) -> None:
+    """Import the ``--plugin`` files/modules (one-line error naming a bad one)."""
+    if specs:
+        from arena.plugins import load_plugins
+
+        load_plugins(specs)
 
 
 @app.command()
@@ -61,6 +79,7 @@ def run(
             "quit",
         ),
     ] = False,
+    plugin: PluginOption = None,
 ) -> None:
     """Run episodes: a robot drives to its goals among people; writes videos and trajectories.
 
@@ -71,6 +90,7 @@ def run(
     from arena.config import load_config
     from arena.experiment import run_experiment
 
+    _load_plugins(plugin)
     items = ([config] if config else []) + list(overrides or [])
     path = None
     if items and "=" not in items[0]:
@@ -186,20 +206,86 @@ def robots() -> None:
 
 
 @app.command()
-def plugins() -> None:
-    """List every plugin registry and the names registered in it."""
-    import arena.plugins  # noqa: F401
-    from arena.core.registry import all_registries
+def plugins(
+    kind: Annotated[
+        str | None, typer.Argument(help="only this kind, e.g. local_planner, crowd_model")
+    ] = None,
+    name: Annotated[
+        str | None, typer.Argument(help="show this plugin's parameters (defaults, units)")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="print JSON")] = False,
+    plugin: PluginOption = None,
+) -> None:
+    """List every plugin registry and the names registered in it; or one plugin's parameters.
 
-    table = Table(title="Plugin registries")
-    table.add_column("kind")
-    table.add_column("name")
-    table.add_column("tags")
-    table.add_column("description")
-    for kind, reg in sorted(all_registries().items()):
-        for i, entry in enumerate(reg.entries()):
-            table.add_row(kind if i == 0 else "", entry.name, ", ".join(entry.tags), entry.summary)
-        table.add_section()
+    On a terminal this prints tables; piped, it prints tab-separated lines (kind, name, tags,
+    description) that no column width truncates; ``--json`` prints JSON.
+    """
+    import json
+
+    from arena.plugins import all_registries, describe_plugin, kind_key, registry_for
+
+    _load_plugins(plugin)
+    if name is not None:
+        _print_plugin(describe_plugin(str(kind), name), as_json)
+        return
+    registries = sorted(all_registries().items())
+    if kind is not None:
+        reg = registry_for(kind)
+        registries = [(reg.kind, reg)]
+    rows = [
+        {"kind": kind_key(k), "name": e.name, "tags": list(e.tags), "description": e.summary}
+        for k, reg in registries
+        for e in reg.entries()
+    ]
+    if as_json:
+        print(json.dumps(rows, indent=2))
+    elif not console.is_terminal:
+        for r in rows:
+            print("\t".join((r["kind"], r["name"], ",".join(r["tags"]), r["description"])))
+    else:
+        table = Table(title="Plugin registries  (arena plugins KIND NAME: parameters)")
+        for col in ("kind", "name", "tags", "description"):
+            table.add_column(col, no_wrap=col == "name")
+        last = None
+        for r in rows:
+            if last is not None and r["kind"] != last:
+                table.add_section()
+            table.add_row(r["kind"] if r["kind"] != last else "", r["name"], ", ".join(r["tags"]),
+                          r["description"])
+            last = r["kind"]
+        console.print(table)
+
+
+def _print_plugin(info: dict, as_json: bool) -> None:
+    """Print ``describe_plugin``'s answer as JSON, a table (terminal) or tab-separated lines."""
+    import json
+
+    if as_json:
+        print(json.dumps(info, indent=2))
+        return
+    cols = ("name", "type", "default", "unit", "constraints", "description")
+    head = f"{info['kind']} {info['name']}" + (f" [{info['unit']}]" if "unit" in info else "")
+    if not console.is_terminal:
+        print(f"# {head}: {info['summary']}  ({info['source']})")
+        if info["parameters"]:
+            print("\t".join(cols))
+        for p in info["parameters"]:
+            print("\t".join(", ".join(p[c]) if c == "constraints" else p[c] for c in cols))
+        return
+    console.print(f"[bold]{head}[/]  ({info['source']})", highlight=False)
+    if info["doc"]:  # the prose, without the Args:/Attributes: sections
+        console.print(re.split(r"\n\s*(?:Args|Attributes|Returns|Raises|Example)s?:\n",
+                               info["doc"])[0], highlight=False)
+    if not info["parameters"]:
+        console.print("no parameters")
+        return
+    table = Table(title=f"parameters  ({info['kind']}: {{type: {info['name']}, KEY: VALUE}})")
+    for col in cols:
+        table.add_column(col, no_wrap=col in ("name", "default"),
+                         ratio=3 if col == "description" else None)
+    for p in info["parameters"]:
+        table.add_row(*(", ".join(p[c]) if c == "constraints" else p[c] for c in cols))
     console.print(table)
 
 
@@ -417,6 +503,7 @@ def bench(
     report: Annotated[
         bool, typer.Option("--report/--no-report", help="then write the HTML report (RUN/report)")
     ] = False,
+    plugin: PluginOption = None,
 ) -> None:
     """Benchmark: every contestant on every episode of a suite; resumable, parallel.
 
@@ -429,6 +516,7 @@ def bench(
     from arena.eval.runner import run_benchmark
     from arena.eval.store import load_results, read_manifest
 
+    _load_plugins(plugin)
     if resume is not None:
         manifest = read_manifest(resume)
         contest = contest if contest is not None else str(manifest.get("contest", "basic"))
@@ -483,6 +571,7 @@ def train(
         typer.Option("--export", help="only write CHECKPOINT/policy.npz from a checkpoint "
                      "folder (RUN/checkpoints/step_N), or the file -o names"),
     ] = None,
+    plugin: PluginOption = None,
 ) -> None:
     r"""Train a PPO policy on arena/SocialNav-v0 (pip install 'arena\[train]').
 
@@ -501,6 +590,7 @@ def train(
     from arena.learn.train_config import TrainSettings
 
     require_sb3()
+    _load_plugins(plugin)
     if export is not None:
         from arena.learn.train import export_checkpoint
 
