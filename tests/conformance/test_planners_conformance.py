@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import copy
 import itertools
-import math
 from pathlib import Path
 from typing import Any
 
@@ -22,23 +21,15 @@ from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
 from arena.nav import (
     GLOBAL_PLANNERS,
-    KINEMATICS,
     LOCAL_PLANNERS,
     GlobalPlanner,
     LocalObservation,
-    LocalPlanner,
 )
-from arena.robots.limits import VelocityLimits
+from arena.nav.local_planners.base import limit_command
+from arena.testing import check_local_planner
+from arena.testing.local_planner import free_road_observation
 
 RES = 0.05
-DT = 0.1
-
-LIMITS = {
-    "diff_drive": VelocityLimits(0.0, 1.0, 0.0, 0.0, 1.5, 1.0, 0.0, 3.0),
-    "legged": VelocityLimits(-0.3, 0.7, 0.0, 0.0, 1.0, 0.8, 0.0, 2.0),
-    "omni": VelocityLimits(-0.8, 0.8, -0.6, 0.6, 1.2, 1.0, 1.0, 2.0),
-    "ackermann": VelocityLimits(0.0, 1.5, 0.0, 0.0, 1.5, 1.0, 0.0, 2.0, min_turning_radius=1.2),
-}
 
 
 def _maze() -> OccupancyGrid:
@@ -129,25 +120,12 @@ PLANNER_PARAMS: dict[str, dict[str, Any]] = {
 """Parameters (besides ``type``) each local planner is built with."""
 
 
-def _free_road_obs(kin: str) -> LocalObservation:
-    return LocalObservation(
-        pose=np.zeros(3),
-        twist=np.zeros(3),
-        goal=Pose2D(3.0, 0.0),
-        path=np.array([[0, 0], [3, 0]]),
-        limits=LIMITS[kin],
-        robot_radius=0.3,
-        dt=DT,
-        kinematics=kin,
-    )
-
-
 @pytest.fixture(scope="session")
 def random_policy_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A random rosnav_rl policy (jackal, lidar + goal + last_action) that drives forward.
 
     The first seed whose untrained policy moves toward a free-road goal ahead is kept, so that
-    :func:`test_local_planner_without_scan` checks the plumbing, not luck.
+    the free-road part of :func:`check_local_planner` checks the plumbing, not luck.
     """
     from arena.learn.config import EnvConfig
     from arena.learn.policy import write_random_policy
@@ -160,7 +138,7 @@ def random_policy_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     for seed in range(100):
         path = write_random_policy(folder / f"random_{seed}.npz", env, robot, rng=seed)
         planner = LearnedPlanner(LearnedPlanner.Params(weights=str(path)))
-        if all(planner.compute(_free_road_obs(k))[0] > 0 for k in sorted(planner.supports)):
+        if all(planner.compute(free_road_observation(k))[0] > 0 for k in sorted(planner.supports)):
             return path
     raise AssertionError("no random policy drives forward")
 
@@ -187,85 +165,40 @@ def _cases() -> list[tuple[str, str]]:
     ]
 
 
-def _random_obs(rng: np.random.Generator, kin: str) -> LocalObservation:
-    lim = LIMITS[kin]
-    twist = rng.uniform(lim.lower, lim.upper)
-    if not lim.holonomic:
-        twist[1] = 0.0
-    if kin == "ackermann":
-        twist[0] = abs(twist[0])
-        twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
-    pose = rng.uniform([-2, -2, -math.pi], [2, 2, math.pi])
-    steps = rng.normal(0, 1.0, (rng.integers(1, 6), 2))
-    path = np.vstack([pose[:2], pose[:2] + np.cumsum(steps, axis=0)])
-    beams = int(rng.integers(0, 60))
-    return LocalObservation(
-        pose=pose,
-        twist=twist,
-        goal=Pose2D(*path[-1], rng.uniform(-3, 3)),
-        path=path,
-        limits=lim,
-        robot_radius=float(rng.uniform(0.1, 0.5)),
-        dt=DT,
-        scan_ranges=rng.uniform(0.05, 6.0, beams),
-        scan_angles=rng.uniform(-math.pi, math.pi, beams),
-        scan_origin=rng.uniform(-0.1, 0.1, 2),
-        time=float(rng.uniform(0, 100)),
-        kinematics=kin,
-    )
-
-
-def _snapshot(obs: LocalObservation) -> dict[str, np.ndarray]:
-    return {
-        k: np.array(getattr(obs, k), copy=True)
-        for k in ("pose", "twist", "path", "scan_ranges", "scan_angles", "scan_origin")
-    }
-
-
 @pytest.mark.parametrize(("name", "kin"), _cases())
 def test_local_planner_conformance(name: str, kin: str, local_spec: Any) -> None:
-    assert kin in KINEMATICS
-    planner = LOCAL_PLANNERS.build(local_spec(name))
-    assert isinstance(planner, LocalPlanner)
-    assert planner.supports <= KINEMATICS
-    rng = np.random.default_rng(12345)
-    observations = []
-    for _ in range(20):  # one episode: a sequence of related observations
-        observations.append(_random_obs(rng, kin))
-    planner.reset()
-    first = []
-    for obs in observations:
-        before = _snapshot(obs)
-        cmd = np.asarray(planner.compute(obs))
-        first.append(cmd.copy())
-        assert cmd.shape == (3,)
-        assert np.all(np.isfinite(cmd))
-        lim = obs.limits
-        assert np.all(cmd >= lim.lower - 1e-9) and np.all(cmd <= lim.upper + 1e-9)
-        room = lim.acceleration * obs.dt + 1e-9
-        assert abs(cmd[0] - obs.twist[0]) <= room[0]
-        assert abs(cmd[1] - obs.twist[1]) <= room[1]
-        if kin == "ackermann":
-            assert abs(cmd[2]) <= abs(cmd[0]) / lim.min_turning_radius + 1e-9
-        else:
-            assert abs(cmd[2] - obs.twist[2]) <= room[2]
-        if not lim.holonomic:
-            assert cmd[1] == 0.0
-        for key, value in before.items():
-            np.testing.assert_array_equal(getattr(obs, key), value, err_msg=f"{key} mutated")
-    # Deterministic: after reset the same sequence gives the same commands.
-    planner.reset()
-    for obs, cmd in zip(observations, first, strict=True):
-        np.testing.assert_array_equal(planner.compute(obs), cmd)
-    other = LOCAL_PLANNERS.build(local_spec(name))
-    for obs, cmd in zip(observations, first, strict=True):
-        np.testing.assert_array_equal(other.compute(obs), cmd)
+    assert LOCAL_PLANNERS.entry(name).summary, "a local planner needs a docstring"
+    check_local_planner(lambda: LOCAL_PLANNERS.build(local_spec(name)), kinematics=[kin])
 
 
-@pytest.mark.parametrize(("name", "kin"), _cases())
-def test_local_planner_without_scan(name: str, kin: str, local_spec: Any) -> None:
-    planner = LOCAL_PLANNERS.build(local_spec(name))
-    obs = _free_road_obs(kin)
-    cmd = planner.compute(obs)
-    assert cmd.shape == (3,) and np.all(np.isfinite(cmd))
-    assert cmd[0] > 0  # free road ahead: it moves toward the goal
+def test_check_local_planner_names_the_broken_rule() -> None:
+    """The checker fails with the planner, the kinematics and the rule in its message."""
+
+    class TooFast:
+        supports = frozenset({"diff_drive"})
+
+        def reset(self) -> None:
+            pass
+
+        def compute(self, obs: LocalObservation) -> np.ndarray:
+            return np.array([obs.limits.vx_max + 1.0, 0.0, 0.0])
+
+    class Mutating(TooFast):
+        def compute(self, obs: LocalObservation) -> np.ndarray:
+            obs.pose[0] += 1.0
+            return np.array(obs.twist, copy=True)
+
+    class Standing(TooFast):  # brakes as hard as allowed, never drives
+        def compute(self, obs: LocalObservation) -> np.ndarray:
+            return limit_command(np.zeros(3), obs.twist, obs.limits, obs.dt)
+
+    with pytest.raises(AssertionError, match=r"TooFast \(diff_drive\), observation 0: command "
+                       r"\[2\., 0\., 0\.\] outside the velocity box"):
+        check_local_planner(TooFast)
+    with pytest.raises(AssertionError, match=r"compute\(\) modified obs\.pose"):
+        check_local_planner(Mutating)
+    with pytest.raises(AssertionError, match="must drive forward"):
+        check_local_planner(Standing)
+    check_local_planner(Standing, moves_on_free_road=False)
+    with pytest.raises(AssertionError, match="does not implement LocalPlanner"):
+        check_local_planner(object)
