@@ -17,7 +17,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from arena.core.errors import ArenaError
+from arena.core.errors import ArenaError, ConfigError
 
 app = typer.Typer(
     add_completion=False,
@@ -68,8 +68,12 @@ def run(
     out: Annotated[Path | None, typer.Option("--out", "-o", help="output folder")] = None,
     video: Annotated[bool | None, typer.Option("--video/--no-video", help="write videos")] = None,
     scenario: Annotated[
-        Path | None,
-        typer.Option("--scenario", help="Arena scenario JSON: robots and obstacles from the file"),
+        str | None,
+        typer.Option(
+            "--scenario",
+            help="Arena scenario JSON (robots and obstacles from the file), or a packaged one by "
+            "name: NAME in the run's world (--map corridor --scenario default) or WORLD/NAME",
+        ),
     ] = None,
     interactive: Annotated[
         bool,
@@ -88,7 +92,7 @@ def run(
     the episode), ``quit`` (stop reading); ``robot=I`` picks another robot.
     """
     from arena.config import load_config
-    from arena.experiment import run_experiment
+    from arena.experiment import run_experiment, run_name
 
     _load_plugins(plugin)
     items = ([config] if config else []) + list(overrides or [])
@@ -110,11 +114,16 @@ def run(
         else:
             items += ["map.type=world", f"map.name={p.resolve() if p.is_dir() else map_}"]
     if scenario is not None:
-        if not scenario.is_file():
-            raise ArenaError(f"--scenario: no such file {str(scenario)!r}")
         import json
 
-        block = json.dumps({"type": "scenario", "file": str(scenario.resolve())})
+        from arena.maps.sources import resolve_scenario
+
+        world = _world_of(load_config(path, items).map)
+        try:
+            file = resolve_scenario(scenario, world)
+        except ConfigError as e:
+            raise ConfigError(e.message, source="--scenario") from None
+        block = json.dumps({"type": "scenario", "file": str(file)})
         items += [f"task.robots={block}", f"task.obstacles={block}"]
     cfg = load_config(path, items)
     extra_modules = []
@@ -127,7 +136,7 @@ def run(
         extra_modules.append(ui)
         _read_commands(ui)
 
-    table = Table(title=f"arena run · {cfg.name}", show_lines=False)
+    table = Table(title=f"arena run · {run_name(cfg)}", show_lines=False)
     for col in ("episode", "outcome", "time [s]", "path [m]", "collisions", "wall [s]"):
         table.add_column(col, justify="right")
     where = cfg.map.get("name") or cfg.map.get("path") or cfg.map["type"]
@@ -161,6 +170,16 @@ def run(
         for kind in ("video", "trajectory"):
             if kind in res.files:
                 console.print(f"{kind + ':':12} {res.files[kind]}")
+
+
+def _world_of(map_spec: dict) -> str | None:
+    """The world (packaged name or folder) a ``map`` block loads, if it loads one."""
+    if map_spec.get("type") == "world":
+        return str(map_spec.get("name"))
+    if map_spec.get("type") == "file" and map_spec.get("path"):
+        folder = Path(str(map_spec["path"])).parent
+        return str(folder.parent if folder.name == "map" else folder)
+    return None
 
 
 def _read_commands(ui) -> None:
@@ -617,7 +636,10 @@ def train(
         settings = settings.model_copy(update={"train": settings.train.model_copy(update=update)})
     run_dir = resume or out
     if run_dir is None:
-        run_dir = Path("runs") / f"train_{cfg.name}_{datetime.now().strftime('%y-%m-%d_%H-%M-%S')}"
+        from arena.experiment import run_name
+
+        stamp = datetime.now().strftime("%y-%m-%d_%H-%M-%S")
+        run_dir = Path("runs") / f"train_{run_name(cfg)}_{stamp}"
     console.print(
         f"[bold]train[/] {cfg.robot} · {settings.train.total_steps} steps · "
         f"{settings.train.n_envs} env(s) · seed "
@@ -692,7 +714,6 @@ def _print_bench_tables(results: object, title: str) -> None:
 
 
 def _write_report(run: Path, out: Path | None, *, videos: int, workers: int) -> None:
-    from arena.core.errors import ConfigError
     from arena.eval.report import main as write_run_report
 
     if not (run / "run.json").is_file():

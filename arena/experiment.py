@@ -23,6 +23,7 @@ import csv
 import dataclasses
 import json
 import math
+import re
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
@@ -437,7 +438,8 @@ def _write_video(
         lidar_specs=robot_specs,
         width_px=cfg.output.width_px,
         title=" · ".join(
-            t for t in (cfg.name, episode.label, states[0].robots.models[0], cfg.crowd["type"]) if t
+            t for t in (run_name(cfg), episode.label, states[0].robots.models[0], cfg.crowd["type"])
+            if t
         ),
         legend=len(states[0].agents) > 0,
     )
@@ -463,9 +465,37 @@ def _write_video(
     return files
 
 
+#: ``ExperimentConfig.name``'s default: a run left unnamed is named after what it runs.
+UNNAMED = ExperimentConfig.model_fields["name"].default
+
+
+def run_name(cfg: ExperimentConfig) -> str:
+    """The run's label: ``cfg.name``, or ``<map>_<robot>_<local planner>`` when it is unnamed.
+
+    Unnamed is the schema default (``name: default`` or no ``name`` key): then the map (world
+    name, map file's world folder or stem, or generator type), the robot preset (or robot file
+    stem) and the local planner name the run, e.g. ``small_office_jackal_pure_pursuit``.
+    """
+    if cfg.name != UNNAMED:
+        return cfg.name
+    spec = cfg.map
+    if spec.get("type") == "world" and spec.get("name"):
+        where = Path(str(spec["name"])).name
+    elif spec.get("type") == "file" and spec.get("path"):
+        path = Path(str(spec["path"]))
+        where = path.parent.parent.name if path.parent.name == "map" else path.stem
+    else:
+        where = str(spec.get("type", "map"))
+    robot = Path(cfg.robot).stem if cfg.robot.endswith((".yaml", ".yml")) else cfg.robot
+    local = str(cfg.navigation.local_planner.get("type", "planner"))
+    # only characters that are safe in a folder name on every system
+    return "_".join(re.sub(r"[^A-Za-z0-9_.-]+", "-", p).strip("-.") or "x"
+                    for p in (where, robot, local))
+
+
 def default_output_dir(cfg: ExperimentConfig) -> Path:
-    """``runs/<name>_<YYYYmmdd-HHMMSS>``."""
-    return Path("runs") / f"{cfg.name}_{datetime.now().strftime('%Y%m%d-%H%M%S')}"
+    """``runs/<run name>_<YYYYmmdd-HHMMSS>`` (see :func:`run_name`)."""
+    return Path("runs") / f"{run_name(cfg)}_{datetime.now().strftime('%Y%m%d-%H%M%S')}"
 
 
 def run_experiment(

@@ -91,8 +91,45 @@ def load_training(
     """
     from arena.config.loader import load_config
 
-    cfg = load_config(path, overrides)
+    cfg = load_config(resolve_training_config(path), overrides)
     return cfg, settings_of(cfg)
+
+
+#: The packaged training configs (``arena train rosnav_rl``).
+TRAIN_CONFIGS_DIR = Path(__file__).resolve().parent / "data" / "train"
+
+
+def packaged_training_configs() -> list[str]:
+    """Names of the packaged training configs (``rlca``, ``rosnav_rl``, ``value_policy``)."""
+    return sorted(p.stem for p in TRAIN_CONFIGS_DIR.glob("*.yaml"))
+
+
+def resolve_training_config(path: str | Path | None) -> str | Path | None:
+    """A YAML path as given, or a packaged config's name turned into its file.
+
+    ``rosnav_rl`` (no such file here, no ``.yaml`` suffix, no folder) names
+    ``arena/learn/data/train/rosnav_rl.yaml``, so the command works from any folder.
+
+    Raises:
+        ConfigError: a bare name that is neither a file nor a packaged config (with a close
+            match and the packaged names).
+    """
+    if path is None or Path(path).exists():
+        return path
+    text = str(path)
+    if Path(text).suffix or "/" in text or os.sep in text:
+        return path  # a file path: load_config reports it missing
+    packaged = TRAIN_CONFIGS_DIR / f"{text}.yaml"
+    if packaged.is_file():
+        return packaged
+    import difflib
+
+    known = packaged_training_configs()
+    close = difflib.get_close_matches(text, known, n=1, cutoff=0.5)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise ConfigError(
+        f"no such file or packaged training config {text!r}; {hint}packaged: {', '.join(known)}"
+    )
 
 
 # -- run folder ---------------------------------------------------------------------------------

@@ -74,6 +74,53 @@ def resolve_world(name_or_folder: str) -> Path:
     )
 
 
+def world_folder(name_or_folder: str) -> Path:
+    """The folder of a packaged world name or world folder (holding ``map/``, ``scenarios/``)."""
+    map_yaml = resolve_world(name_or_folder)
+    return map_yaml.parent.parent if map_yaml.parent.name == "map" else map_yaml.parent
+
+
+def resolve_scenario(name_or_file: str, world: str | None = None) -> Path:
+    """An Arena scenario file: a path, ``WORLD/NAME`` or a ``NAME`` in ``world``.
+
+    ``corridor/default`` is the packaged world ``corridor``'s ``scenarios/default.json``;
+    ``default`` with ``world="corridor"`` (a packaged world name or a world folder) the same.
+    Names let commands work from any folder; an existing file always wins.
+
+    Raises:
+        ConfigError: a missing file, an unknown world or scenario (with the world's scenarios).
+    """
+    path = Path(name_or_file).expanduser()
+    if path.is_file():
+        return path.resolve()
+    text = str(name_or_file).removesuffix(".json")
+    parts = text.split("/")
+    if len(parts) == 2 and all(parts) and (WORLDS_DIR / parts[0]).is_dir():
+        world, name = parts
+    elif len(parts) == 1 and text and world is not None:
+        name = text
+    elif len(parts) == 1 and text:
+        raise ConfigError(
+            f"no scenario file {name_or_file!r}; a scenario name needs a world: WORLD/{text} or "
+            "--map WORLD"
+        )
+    else:
+        raise ConfigError(f"no such scenario file {name_or_file!r}")
+    folder = world_folder(world) / "scenarios"
+    candidate = folder / f"{name}.json"
+    if candidate.is_file():
+        return candidate
+    import difflib
+
+    known = sorted(p.stem for p in folder.glob("*.json")) if folder.is_dir() else []
+    close = difflib.get_close_matches(name, known, n=1, cutoff=0.5)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise ConfigError(
+        f"no scenario {name!r} in world {world!r} ({folder}); {hint}"
+        f"scenarios: {', '.join(known) or '(none)'}"
+    )
+
+
 @MAP_SOURCES.register("world", tags=("file",))
 class WorldMap:
     """A packaged world by name, or any folder in Arena's layout (``<folder>/map/map.yaml``)."""
