@@ -344,8 +344,18 @@ def maps_generate(
     seed: Annotated[int, typer.Option(help="seed")] = 0,
     out: Annotated[Path, typer.Option("--out", "-o", help="output world folder")] = Path("."),
     width_px: Annotated[int, typer.Option(help="preview width")] = 800,
+    burn_obstacles: Annotated[
+        bool,
+        typer.Option("--burn-obstacles/--no-burn-obstacles",
+                     help="draw the placed obstacles into map.png as occupied cells (for ROS "
+                     "map_server / RViz, and arena run --map FOLDER, which read only the map)"),
+    ] = False,
 ) -> None:
-    """Generate a map: ROS map files, placed obstacles (scenario JSON) and a PNG preview."""
+    """Generate a map: ROS map files, placed obstacles (scenario JSON) and a PNG preview.
+
+    map.png holds the generator's walls; the placed obstacles (tables, shelves ...) are in
+    obstacles.json unless ``--burn-obstacles`` draws them into map.png too.
+    """
     import arena.plugins  # noqa: F401
     from arena.config.loader import parse_override
     from arena.core.rng import derive_rng
@@ -360,14 +370,15 @@ def maps_generate(
         spec[key] = value
     generator = MAP_GENERATORS.build(spec, source="command line")
     result = generator.build(derive_rng(seed, "map"))
-    files = write_world(result, out)
+    files = write_world(result, out, burn_obstacles=burn_obstacles)
     world = StaticWorld.build(result.grid, result.obstacles)
     preview = out / "preview.png"
     save_png(render_world(world, width_px=width_px, title=f"{kind} · seed {seed}"), preview)
     w, h = result.grid.size_m
+    burnt = " (burnt into map.png)" if burn_obstacles and result.obstacles else ""
     console.print(
-        f"{kind}: {w:.1f} × {h:.1f} m, {len(result.obstacles)} obstacles, "
-        f"{100 * result.grid.occupied.mean():.1f} % occupied"
+        f"{kind}: {w:.1f} × {h:.1f} m, {len(result.obstacles)} obstacles{burnt}, "
+        f"{100 * result.grid.occupied.mean():.1f} % occupied by walls"
     )
     for label, path in (*files.items(), ("preview", preview)):
         console.print(f"{label + ':':10} {path}")

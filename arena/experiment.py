@@ -44,7 +44,7 @@ from arena.eval.counterfactual import align, replay_crowd
 from arena.eval.io import save_record
 from arena.eval.record import EpisodeMeta, EpisodeRecord
 from arena.eval.recorder import Recorder
-from arena.maps.raster import polygon_mask
+from arena.maps.raster import burn_obstacles
 from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack, NavStatus
@@ -111,11 +111,7 @@ def make_episode(
 
 def planning_grid(episode: Episode):
     """The map with the known static obstacles burnt in: what the global planner plans on."""
-    if not episode.obstacles:
-        return episode.grid
-    return episode.grid.with_occupied(
-        polygon_mask(episode.grid, [o.polygon for o in episode.obstacles])
-    )
+    return burn_obstacles(episode.grid, episode.obstacles)
 
 
 class EpisodeRecorder:

@@ -97,6 +97,18 @@ def polygon_mask(grid: OccupancyGrid, polygons: Sequence[NDArray[np.float64]]) -
     return mask
 
 
+def burn_obstacles(grid: OccupancyGrid, obstacles: Sequence[Any]) -> OccupancyGrid:
+    """A copy of ``grid`` with the cells the obstacles' polygons overlap marked occupied.
+
+    What the global planner plans on, and what ``arena maps generate --burn-obstacles`` writes
+    so that map-only tools (ROS ``map_server``, RViz) see placed obstacles. ``obstacles``: any
+    objects with a ``polygon`` ``(k, 2)`` in metres (:class:`~arena.sim.state.Obstacle`).
+    """
+    if not obstacles:
+        return grid
+    return grid.with_occupied(polygon_mask(grid, [o.polygon for o in obstacles]))
+
+
 def polygon_window(
     grid: OccupancyGrid, polygon: NDArray[np.float64]
 ) -> tuple[int, int, NDArray[np.bool_]] | None:

@@ -187,19 +187,25 @@ class EmptyMap:
         return MapResult("empty", OccupancyGrid.empty(p.width, p.height, p.resolution))
 
 
-def write_world(result: MapResult, folder: str | Path) -> dict[str, Path]:
+def write_world(
+    result: MapResult, folder: str | Path, *, burn_obstacles: bool = False
+) -> dict[str, Path]:
     """Save a map as an Arena-style world folder.
 
     Writes ``<folder>/map/map.yaml`` + ``map.png`` (ROS map_server) and
     ``<folder>/map/obstacles.json``: the placed obstacles in Arena's scenario format
-    (``{"obstacles": {"static": [{"name", "model", "pos": [x, y, yaw]}]}}``).
+    (``{"obstacles": {"static": [{"name", "model", "pos": [x, y, yaw]}]}}``). With
+    ``burn_obstacles`` the cells the obstacles overlap are occupied in ``map.png`` too, so that
+    tools that read only the map (ROS ``map_server``, RViz, ``arena run --map FOLDER``) see them.
     """
     import json
 
     from arena.maps.io import save_map
+    from arena.maps.raster import burn_obstacles as burn
 
     folder = Path(folder)
-    yaml_path = save_map(result.grid, folder / "map" / "map.yaml", image_format="png")
+    grid = burn(result.grid, result.obstacles) if burn_obstacles else result.grid
+    yaml_path = save_map(grid, folder / "map" / "map.yaml", image_format="png")
     static = [
         {"name": o.name, "model": o.model, "pos": [round(float(v), 6) for v in o.pose]}
         for o in result.obstacles
