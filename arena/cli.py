@@ -161,15 +161,52 @@ def run(
             f"{res.wall_time:.1f}",
         )
 
-    out_dir, results = run_experiment(
-        cfg, out, on_episode=show, modules=extra_modules, realtime=interactive
-    )
+    bar, on_step = _episode_progress(enabled=console.is_terminal and not interactive)
+    with bar:
+        out_dir, results = run_experiment(
+            cfg, out, on_episode=show, modules=extra_modules, realtime=interactive,
+            on_step=on_step,
+        )
     console.print(table)
-    console.print(f"results:     {out_dir}/summary.csv")
+    console.print(f"results:     {out_dir}/summary.csv", soft_wrap=True)
     for res in results:
         for kind in ("video", "trajectory"):
             if kind in res.files:
-                console.print(f"{kind + ':':12} {res.files[kind]}")
+                console.print(f"{kind + ':':12} {res.files[kind]}", soft_wrap=True)
+
+
+def _episode_progress(*, enabled: bool):
+    """A progress bar of simulated time against the episode's time limit, and its callback.
+
+    On a terminal the bar shows the running episode (``on_step(episode, time, limit)``);
+    otherwise (piped, logged) nothing is drawn and the one line per finished episode that
+    ``arena run`` prints is the progress.
+    """
+    from contextlib import nullcontext
+
+    if not enabled:
+        return nullcontext(), None
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    bar = Progress(
+        TextColumn("episode {task.fields[episode]}"),
+        BarColumn(),
+        TextColumn("{task.completed:5.1f} / {task.total:.0f} s simulated"),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+    )
+    tasks: dict[int, object] = {}
+
+    def on_step(episode: int, time: float, limit: float) -> None:
+        if episode not in tasks:
+            for done in tasks.values():  # the previous episode has ended
+                bar.remove_task(done)
+            tasks.clear()
+            tasks[episode] = bar.add_task("", total=limit, episode=episode)
+        bar.update(tasks[episode], completed=min(time, limit))
+
+    return bar, on_step
 
 
 def _world_of(map_spec: dict) -> str | None:

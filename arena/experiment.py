@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import functools
 import json
 import math
 import re
@@ -81,14 +82,18 @@ class EpisodeResult:
     control_ms_p95: float = 0.0
     control_ms_max: float = 0.0
     files: dict[str, str] = field(default_factory=dict)
+    #: Every registered metric of the episode (:func:`episode_metrics`), set by
+    #: :func:`run_experiment`; in summary.csv, not in episode.json.
+    metrics: dict[str, float] = field(default_factory=dict, compare=False)
     #: The full step-by-step record (not part of :meth:`summary`, episode.json or summary.csv;
     #: on disk it is ``files["record"]``, ``episode.parquet``).
     record: EpisodeRecord | None = field(default=None, repr=False, compare=False)
 
     def summary(self) -> dict[str, Any]:
-        """The figures as plain data (every field but ``record``), as in episode.json."""
+        """The figures as plain data, as in episode.json (all fields but record, metrics)."""
         return {
-            f.name: getattr(self, f.name) for f in fields(self) if f.name != "record"
+            f.name: getattr(self, f.name) for f in fields(self)
+            if f.name not in ("record", "metrics")
         }
 
 
@@ -223,6 +228,7 @@ def run_episode(
     video: bool = False,
     runtime: TaskRuntime | None = None,
     realtime: bool = False,
+    on_step: Callable[[float, float], None] | None = None,
 ) -> EpisodeResult:
     """Simulate one episode with the configured navigation stack and write its files.
 
@@ -231,7 +237,8 @@ def run_episode(
     reaches its goal. Every step its update is applied: teleports move the robot (backend
     ``teleport``, the stack plans afresh), new goals make the stack replan, and a forced reset
     ends the episode as ``aborted``. ``realtime`` paces the loop to ``dt`` of wall time per
-    step (interactive runs).
+    step (interactive runs). ``on_step(time, time_limit)`` (both s) is called after each
+    simulated step (progress displays).
 
     The stack's goal tolerances follow the episode: position within ``0.9 · goal_radius`` (or
     the navigation config's, if smaller) and, when the task checks the heading
@@ -336,6 +343,8 @@ def run_episode(
                 if ahead > 0:
                     time.sleep(ahead)
             state = backend.step(cmd[None, :], dt)
+            if on_step is not None:
+                on_step(state.time, episode.time_limit)
             recorder.record(state)
             rec.record(state)
             if video:
@@ -501,6 +510,7 @@ def run_experiment(
     on_episode: Callable[[EpisodeResult], None] | None = None,
     modules: Sequence[Any] = (),
     realtime: bool = False,
+    on_step: Callable[[int, float, float], None] | None = None,
 ) -> tuple[Path, list[EpisodeResult]]:
     """Run every episode of ``cfg`` and write the outputs under ``out_dir``.
 
@@ -511,6 +521,10 @@ def run_experiment(
         modules: task module instances added after the config's (the CLI's interactive
             module, which it feeds from stdin).
         realtime: pace the simulation to wall-clock time (interactive runs).
+        on_step: ``on_step(episode, time, time_limit)`` after each simulated step (s).
+
+    ``summary.csv`` has one row per episode: its figures, then every registered metric
+    (:func:`episode_metrics`, the values ``arena bench`` stores).
     """
     robot = load_robot(cfg.robot)
     backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
@@ -534,13 +548,36 @@ def run_experiment(
             video=video,
             runtime=generator.runtime(episode),
             realtime=realtime,
+            on_step=None if on_step is None else functools.partial(on_step, i),
         )
+        res.metrics, problem = episode_metrics(res.record)
+        if problem:
+            res.error = f"{res.error}; {problem}" if res.error else problem
         generator.feedback(i, res.outcome)
         results.append(res)
         if on_episode:
             on_episode(res)
     _write_summary(out / "summary.csv", results)
     return out, results
+
+
+def episode_metrics(record: EpisodeRecord | None) -> tuple[dict[str, float], str]:
+    """Every registered metric of one episode (what ``arena bench`` stores per episode).
+
+    Returns:
+        ``{metric: value}`` (NaN where undefined; all NaN without a record or when a metric
+        raises, so that a faulty metric plugin costs its figures, not the run) and ``""``, or
+        that error as ``"metrics: <Type>: message"``.
+    """
+    from arena.eval.metrics import METRICS, compute_metrics
+
+    if record is not None:
+        try:
+            return compute_metrics(record), ""
+        except Exception as e:
+            nan = {n: math.nan for n in METRICS.names()}
+            return nan, f"metrics: {type(e).__name__}: {e}"
+    return {n: math.nan for n in METRICS.names()}, ""
 
 
 def _write_summary(path: Path, results: list[EpisodeResult]) -> None:
@@ -563,9 +600,12 @@ def _write_summary(path: Path, results: list[EpisodeResult]) -> None:
         "wall_time",
         "error",
     ]
+    # then every metric (path_length and collisions: the episode's own figures, as in bench)
+    metrics = list(dict.fromkeys(m for r in results for m in r.metrics if m not in cols))
     with path.open("w", newline="") as f:
         w = csv.writer(f)
-        w.writerow(cols)
+        w.writerow(cols + metrics)
         for r in results:
             d = r.summary()
-            w.writerow([f"{d[c]:.4f}" if isinstance(d[c], float) else d[c] for c in cols])
+            w.writerow([f"{d[c]:.4f}" if isinstance(d[c], float) else d[c] for c in cols]
+                       + [f"{r.metrics.get(m, math.nan):.6g}" for m in metrics])
