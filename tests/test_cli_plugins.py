@@ -222,3 +222,63 @@ def test_bench_with_a_plugin_planner_on_two_workers(monkeypatch, capsys, tmp_pat
     rows = load_results(run).to_pylist()
     assert [r["local_planner"] for r in rows] == [name, name]
     assert [r["outcome"] for r in rows] == ["success", "success"], [r["error"] for r in rows]
+
+
+def test_train_names_a_bad_plugin(monkeypatch, capsys, tmp_path):
+    monkeypatch.delenv("ARENA_PLUGINS", raising=False)
+    code, _, err = run_cli(monkeypatch, capsys, "train", "--plugin", str(tmp_path / "gone.py"),
+                           "-o", str(tmp_path / "t"))
+    assert code == 2
+    assert err.strip() == f"error: {tmp_path / 'gone.py'}: no such plugin file"
+    assert not (tmp_path / "t").exists()
+
+
+CROWD = '''
+"""A user's crowd model: walk straight at the destination."""
+import numpy as np
+
+from arena.crowd.base import CROWD_MODELS, ModelOutput
+
+
+@CROWD_MODELS.register("{name}")
+class Straight:
+    """Walk straight at the destination at full speed."""
+
+    output = "acceleration"
+
+    def neighbor_cutoff(self):
+        return 0.0
+
+    def reset(self, state, world, rng):
+        pass
+
+    def compute(self, frame):
+        s = frame.state
+        d = frame.destinations - s.positions
+        v = d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-9) * s.vmax[:, None]
+        acc = np.where(frame.active[:, None], (v - s.velocities) / 0.5, 0.0)
+        return ModelOutput(accelerations=acc)
+'''
+
+
+@pytest.mark.slow
+def test_train_with_a_plugin_crowd_in_subprocess_envs(monkeypatch, capsys, tmp_path):
+    """``arena train``'s subprocess environments import the plugin file too."""
+    import arena.plugins as plugins
+    from arena.crowd.base import CROWD_MODELS
+
+    monkeypatch.delenv(plugins.PLUGINS_ENV, raising=False)
+    path = tmp_path / "my_crowd.py"
+    path.write_text(CROWD.format(name="straight_e_train"))
+    try:
+        code, out, err = run_cli(
+            monkeypatch, capsys, "train", "--plugin", str(path), "crowd.type=straight_e_train",
+            "--steps", "64", "--envs", "2", "--no-progress", "-o", str(tmp_path / "run"),
+            "learning.train.vec_env=subproc", "learning.ppo.batch_size=64",
+            "learning.ppo.minibatch_size=32", "learning.ppo.n_epochs=1",
+            "learning.train.tensorboard=false",
+        )
+    finally:
+        CROWD_MODELS._entries.pop("straight_e_train", None)
+    assert code == 0, err
+    assert "64 steps" in out and (tmp_path / "run" / "policy.npz").is_file()
