@@ -7,7 +7,6 @@ with status 2; no traceback. ``ARENA_DEBUG=1`` shows the traceback anyway.
 from __future__ import annotations
 
 import os
-import re
 import sys
 from enum import StrEnum
 from pathlib import Path
@@ -161,7 +160,9 @@ def run(
             f"{res.wall_time:.1f}",
         )
 
-    bar, on_step = _episode_progress(enabled=console.is_terminal and not interactive)
+    from arena.cli_views import episode_progress
+
+    bar, on_step = episode_progress(console, enabled=console.is_terminal and not interactive)
     with bar:
         out_dir, results = run_experiment(
             cfg, out, on_episode=show, modules=extra_modules, realtime=interactive,
@@ -173,40 +174,6 @@ def run(
         for kind in ("video", "trajectory"):
             if kind in res.files:
                 console.print(f"{kind + ':':12} {res.files[kind]}", soft_wrap=True)
-
-
-def _episode_progress(*, enabled: bool):
-    """A progress bar of simulated time against the episode's time limit, and its callback.
-
-    On a terminal the bar shows the running episode (``on_step(episode, time, limit)``);
-    otherwise (piped, logged) nothing is drawn and the one line per finished episode that
-    ``arena run`` prints is the progress.
-    """
-    from contextlib import nullcontext
-
-    if not enabled:
-        return nullcontext(), None
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
-
-    bar = Progress(
-        TextColumn("episode {task.fields[episode]}"),
-        BarColumn(),
-        TextColumn("{task.completed:5.1f} / {task.total:.0f} s simulated"),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-    )
-    tasks: dict[int, object] = {}
-
-    def on_step(episode: int, time: float, limit: float) -> None:
-        if episode not in tasks:
-            for done in tasks.values():  # the previous episode has ended
-                bar.remove_task(done)
-            tasks.clear()
-            tasks[episode] = bar.add_task("", total=limit, episode=episode)
-        bar.update(tasks[episode], completed=min(time, limit))
-
-    return bar, on_step
 
 
 def _world_of(map_spec: dict) -> str | None:
@@ -277,72 +244,10 @@ def plugins(
     On a terminal this prints tables; piped, it prints tab-separated lines (kind, name, tags,
     description) that no column width truncates; ``--json`` prints JSON.
     """
-    import json
-
-    from arena.plugins import all_registries, describe_plugin, kind_key, registry_for
+    from arena.cli_views import print_plugins
 
     _load_plugins(plugin)
-    if name is not None:
-        _print_plugin(describe_plugin(str(kind), name), as_json)
-        return
-    registries = sorted(all_registries().items())
-    if kind is not None:
-        reg = registry_for(kind)
-        registries = [(reg.kind, reg)]
-    rows = [
-        {"kind": kind_key(k), "name": e.name, "tags": list(e.tags), "description": e.summary}
-        for k, reg in registries
-        for e in reg.entries()
-    ]
-    if as_json:
-        print(json.dumps(rows, indent=2))
-    elif not console.is_terminal:
-        for r in rows:
-            print("\t".join((r["kind"], r["name"], ",".join(r["tags"]), r["description"])))
-    else:
-        table = Table(title="Plugin registries  (arena plugins KIND NAME: parameters)")
-        for col in ("kind", "name", "tags", "description"):
-            table.add_column(col, no_wrap=col == "name")
-        last = None
-        for r in rows:
-            if last is not None and r["kind"] != last:
-                table.add_section()
-            table.add_row(r["kind"] if r["kind"] != last else "", r["name"], ", ".join(r["tags"]),
-                          r["description"])
-            last = r["kind"]
-        console.print(table)
-
-
-def _print_plugin(info: dict, as_json: bool) -> None:
-    """Print ``describe_plugin``'s answer as JSON, a table (terminal) or tab-separated lines."""
-    import json
-
-    if as_json:
-        print(json.dumps(info, indent=2))
-        return
-    cols = ("name", "type", "default", "unit", "constraints", "description")
-    head = f"{info['kind']} {info['name']}" + (f" [{info['unit']}]" if "unit" in info else "")
-    if not console.is_terminal:
-        print(f"# {head}: {info['summary']}  ({info['source']})")
-        if info["parameters"]:
-            print("\t".join(cols))
-        for p in info["parameters"]:
-            print("\t".join(", ".join(p[c]) if c == "constraints" else p[c] for c in cols))
-        return
-    console.print(f"[bold]{head}[/]  ({info['source']})", highlight=False)
-    if info["doc"]:  # the prose, without the Args:/Attributes: sections
-        console.print(re.split(r"\n\s*(?:Args|Attributes|Returns|Raises|Example)s?:\n",
-                               info["doc"])[0], highlight=False)
-    if not info["parameters"]:
-        console.print("no parameters")
-        return
-    table = Table(title=f"parameters  ({info['kind']}: {{type: {info['name']}, KEY: VALUE}})")
-    for col in cols:
-        table.add_column(col, no_wrap=col in ("name", "default"),
-                         ratio=3 if col == "description" else None)
-    for p in info["parameters"]:
-        table.add_row(*(", ".join(p[c]) if c == "constraints" else p[c] for c in cols))
-    console.print(table)
+    print_plugins(console, kind, name, as_json=as_json)
 
 
 maps_app = typer.Typer(help="Generate and list maps.", no_args_is_help=True)

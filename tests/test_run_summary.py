@@ -9,6 +9,7 @@ import sys
 import pytest
 
 from arena import cli
+from arena.cli_views import episode_progress
 from arena.config import load_config
 from arena.eval.io import load_record
 from arena.eval.metrics import METRICS, Metric, compute_metrics
@@ -84,7 +85,7 @@ def test_a_faulty_metric_costs_its_figures_not_the_run(tmp_path):
 
 
 def test_cli_progress_bar_follows_the_episode(monkeypatch):
-    bar, on_step = cli._episode_progress(enabled=True)
+    bar, on_step = episode_progress(cli.console, enabled=True)
     with bar:
         on_step(0, 0.1, 30.0)
         on_step(0, 2.5, 30.0)
@@ -93,7 +94,7 @@ def test_cli_progress_bar_follows_the_episode(monkeypatch):
         on_step(1, 0.1, 45.0)
         (task,) = bar.tasks  # the finished episode's bar is gone
         assert (task.completed, task.total, task.fields["episode"]) == (0.1, 45.0, 1)
-    bar, on_step = cli._episode_progress(enabled=False)
+    bar, on_step = episode_progress(cli.console, enabled=False)
     assert on_step is None
 
 
