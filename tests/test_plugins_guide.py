@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from arena.plugins import load_plugins
+from arena.plugins import all_registries, load_plugins
 from arena.testing import check_crowd_model, check_local_planner, check_task_mode
 from tests.eval._records import make_record
 
@@ -30,14 +31,19 @@ def _files() -> dict[str, str]:
 
 
 @pytest.fixture(scope="module")
-def guide_plugins(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+def guide_plugins(tmp_path_factory: pytest.TempPathFactory) -> Iterator[dict[str, Path]]:
     folder = tmp_path_factory.mktemp("guide")
     paths = {}
     for name, source in _files().items():
         paths[name] = folder / name
         paths[name].write_text(source, encoding="utf-8")
+    before = {kind: set(reg.names()) for kind, reg in all_registries().items()}
     load_plugins([str(p) for p in paths.values()], export=False)
-    return paths
+    yield paths
+    # leave the registries as other test modules expect them
+    for kind, reg in all_registries().items():
+        for name in set(reg.names()) - before.get(kind, set()):
+            reg._entries.pop(name)
 
 
 def test_the_guide_has_one_example_per_kind() -> None:
