@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import os
 import sys
 import textwrap
 
@@ -282,3 +283,33 @@ def test_train_with_a_plugin_crowd_in_subprocess_envs(monkeypatch, capsys, tmp_p
         CROWD_MODELS._entries.pop("straight_e_train", None)
     assert code == 0, err
     assert "64 steps" in out and (tmp_path / "run" / "policy.npz").is_file()
+
+
+def test_plugin_by_module_name_from_the_working_folder(monkeypatch, capsys, tmp_path):
+    import arena.plugins as plugins
+    from arena.eval.metrics import METRICS
+
+    monkeypatch.delenv(plugins.PLUGINS_ENV, raising=False)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "path", list(sys.path))  # the working folder is added for names
+    (tmp_path / "lab_metrics_e.py").write_text(textwrap.dedent('''
+        from arena.eval.metrics import metric
+
+        @metric("wheel_time_e", unit="s", description="time with any wheel command")
+        def wheel_time(record, params):
+            """s, number of rows times dt."""
+            return float(len(record.time) * record.meta.dt)
+    '''))
+    try:
+        code, out, err = run_cli(monkeypatch, capsys, "plugins", "metric", "wheel_time_e",
+                                 "--plugin", "lab_metrics_e", "--json")
+        assert code == 0, err
+        info = json.loads(out)
+        assert (info["unit"], info["summary"]) == ("s", "time with any wheel command")
+        assert info["source"] == "lab_metrics_e.wheel_time"
+        # exported for worker processes
+        assert os.environ[plugins.PLUGINS_ENV].split(os.pathsep) == ["lab_metrics_e"]
+    finally:
+        METRICS._entries.pop("wheel_time_e", None)
+        plugins._loaded.pop("lab_metrics_e", None)
+        sys.modules.pop("lab_metrics_e", None)
