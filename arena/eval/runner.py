@@ -371,6 +371,10 @@ def _ray_init(ray: Any, workers: int, address: str | None) -> str | None:
     kwargs: dict[str, Any] = {
         "include_dashboard": False, "log_to_driver": False, "logging_level": logging.ERROR,
     }
+    from arena.plugins import PLUGINS_ENV
+
+    if os.environ.get(PLUGINS_ENV):  # ray workers import the same --plugin files (arena.plugins)
+        kwargs["runtime_env"] = {"env_vars": {PLUGINS_ENV: os.environ[PLUGINS_ENV]}}
     if address is not None:
         ray.init(address=address, **kwargs)
         return None
