@@ -52,7 +52,8 @@ _loaded: dict[str, ModuleType] = {}  # resolved spec -> module (each plugin impo
 
 
 def _is_path(spec: str) -> bool:
-    return spec.endswith(".py") or "/" in spec or os.sep in spec or Path(spec).exists()
+    # a bare name that is a folder (a package in the working folder) is a module name
+    return spec.endswith(".py") or "/" in spec or os.sep in spec or Path(spec).is_file()
 
 
 def _resolve(spec: str) -> str:
