@@ -26,6 +26,7 @@ import numpy as np  # noqa: E402
 
 import arena.crowd  # noqa: E402, F401
 from arena.crowd.base import CROWD_MODELS  # noqa: E402
+from arena.crowd.models.rvo2 import world_polygons  # noqa: E402
 from arena.crowd.simulator import CrowdSimulator, PedestrianConfig  # noqa: E402
 from arena.crowd.walls import world_segments  # noqa: E402
 from arena.maps.grid import OccupancyGrid  # noqa: E402
@@ -150,9 +151,8 @@ def time_pyrvo(world: StaticWorld, n: int, steps: int) -> float | None:
     sim.set_agent_defaults(2.0, 10, 5.0, 2.0, 0.3, 1.4, (0.0, 0.0))
     for p in sp.positions:
         sim.add_agent((float(p[0]), float(p[1])))
-    a, b = world_segments(world)
-    for p, q in zip(a, b, strict=True):
-        sim.add_obstacle([(float(p[0]), float(p[1])), (float(q[0]), float(q[1]))])
+    for poly in world_polygons(world):  # the obstacles our rvo2 model gets
+        sim.add_obstacle([(float(x), float(y)) for x, y in poly])
     sim.process_obstacles()
     total = 0.0
     for _ in range(steps + 1):

@@ -6,6 +6,13 @@ and keeps at least ``clearance`` from it (pushed out along the wall normal, whic
 the velocity component into the wall, so agents slide along walls). Models' wall forces do the
 steering; the guard makes "no agent walks through a wall" hold for every model, including
 deliberately odd ones like ``spinny``.
+
+The speed cap holds exactly, after the guard too: ``sqrt(vx² + vy²) ≤ vmax·vmax_factor`` for the
+returned velocity of every agent, computed in float64 as written (:func:`cap_speed` re-checks
+its own rescaling). A push-out longer than the cap allows (an agent that starts inside a wall's
+clearance, or squeezed at a corner) is shortened to the cap along its own direction (a part of
+the guarded move): the agent gets its clearance back over the next steps, at its walking speed,
+instead of jumping.
 """
 
 from __future__ import annotations
@@ -138,12 +145,9 @@ def _integrate(
             vx, vy = update[i, 0], update[i, 1]
         else:
             vx, vy = vel[i, 0] + update[i, 0] * dt, vel[i, 1] + update[i, 1] * dt
-        sp = math.sqrt(vx * vx + vy * vy)
         cap = vmax[i] * vmax_factor[i] if has_factor else vmax[i]
-        if sp > cap:
-            k = cap / max(sp, 1e-12)
-            vx, vy = vx * k, vy * k
-            sp = cap
+        vx, vy = cap_speed(vx, vy, cap)
+        sp = math.sqrt(vx * vx + vy * vy)
         x0, y0 = pos[i, 0], pos[i, 1]
         x1, y1 = x0 + vx * dt, y0 + vy * dt
         step = sp * dt
@@ -176,9 +180,32 @@ def _integrate(
                         cand[m] = j
                         m += 1
         qx, qy = _guard_one(x0, y0, x1, y1, clear, wa, wb, cand, 0, m)
+        ux, uy = (qx - x0) / dt, (qy - y0) / dt
+        if math.sqrt(ux * ux + uy * uy) > cap:
+            # The push-out made the move longer than the cap: the first part of it, at the cap.
+            ux, uy = cap_speed(ux, uy, cap)
+            qx, qy = x0 + ux * dt, y0 + uy * dt
         new_p[i, 0], new_p[i, 1] = qx, qy
-        new_v[i, 0], new_v[i, 1] = (qx - x0) / dt, (qy - y0) / dt
+        new_v[i, 0], new_v[i, 1] = ux, uy
     return new_p, new_v
+
+
+@njit(cache=True, inline="always")
+def cap_speed(vx: float, vy: float, cap: float) -> tuple[float, float]:
+    """``(vx, vy)`` scaled down to ``sqrt(vx² + vy²) ≤ cap`` exactly (m/s; ``cap ≥ 0``).
+
+    The rescaled vector's norm, rounded, can exceed ``cap`` by an ulp; it is shrunk by a few
+    ulps more until the check, computed the same way, holds. Vectors within the cap (and NaN)
+    are returned unchanged.
+    """
+    sp = math.sqrt(vx * vx + vy * vy)
+    if not sp > cap:
+        return vx, vy
+    k = cap / sp
+    vx, vy = vx * k, vy * k
+    while math.sqrt(vx * vx + vy * vy) > cap:
+        vx, vy = vx * (1.0 - 2e-16), vy * (1.0 - 2e-16)
+    return vx, vy
 
 
 def guard_walls(

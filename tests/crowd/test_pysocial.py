@@ -32,7 +32,9 @@ from arena.testing.conformance import check_crowd_model
 # group coherence (Alt), group repulsion, group gaze (Alt).
 REF_TERMS = ("desired", "social", "obstacle", "group_coherence", "group_repulsion", "group_gaze")
 EXACT = {"cutoff": math.inf, "robot_factor": 0.0, "force_scale": 1.0}
-RTOL = 1e-6
+# README: "forces equal to 2e-15" of the largest reference force (measured: at most 1.1e-15,
+# 2026-11-27, on x86-64 with AVX-512, where numpy's SIMD exp/arctan2 differ most from libm).
+RTOL = 2e-15
 
 
 @pytest.fixture(scope="module")
@@ -189,13 +191,10 @@ def rel_error(a: np.ndarray, ref: np.ndarray) -> float:
 
 def assert_matches(out: Any, total: np.ndarray, terms: dict[str, np.ndarray]) -> None:
     for name, ref in terms.items():
-        assert rel_error(out.forces[name], ref) <= RTOL, name
-        scale = max(float(np.max(np.abs(ref), initial=0.0)), 1e-300)
-        np.testing.assert_allclose(out.forces[name], ref, rtol=RTOL, atol=1e-12 * scale)
-    assert rel_error(out.accelerations, total) <= RTOL
-    np.testing.assert_allclose(
-        out.accelerations, total, rtol=RTOL, atol=1e-12 * np.abs(total).max()
-    )
+        err = rel_error(out.forces[name], ref)
+        assert err <= RTOL, f"{name}: {err:.3g} of the largest force"
+    err = rel_error(out.accelerations, total)
+    assert err <= RTOL, f"total: {err:.3g} of the largest force"
 
 
 # -- reference ------------------------------------------------------------------------------------

@@ -61,6 +61,95 @@ def test_speed_capped_and_acceleration_bounded():
     assert np.all(acc <= WaypointWalker.Params().max_acceleration + 1e-6)
 
 
+def boxed_room(n, size, seed=0):
+    """``n`` people (0.25 m) in a walled ``size`` m square room with two boxes.
+
+    Everyone starts clear of walls, boxes and each other and loops through 4 random waypoints.
+    Returns ``(world, spawn)``.
+    """
+    from arena.core.geometry import rectangle
+    from arena.crowd.simulator import crowd_clearance
+
+    occ = np.zeros((round(size / 0.1),) * 2, dtype=bool)
+    occ[:3] = occ[-3:] = occ[:, :3] = occ[:, -3:] = True
+    grid = OccupancyGrid.from_occupied(occ, 0.1)
+    boxes = tuple(
+        Obstacle(f"box{k}", "box", np.array([x * size, y * size, 0.3]), rectangle(1.0, 0.8))
+        for k, (x, y) in enumerate([(0.3, 0.5), (0.7, 0.4)])
+    )
+    world = StaticWorld.build(grid, boxes)
+    clear = crowd_clearance(grid, [b.polygon for b in boxes])
+    rng = np.random.default_rng(seed)
+    pts: list[np.ndarray] = []
+    while len(pts) < n:
+        p = rng.uniform(0.8, size - 0.8, 2)
+        if clear[int(p[1] / 0.1), int(p[0] / 0.1)] > 0.5 and all(
+            np.hypot(*(p - q)) > 0.55 for q in pts
+        ):
+            pts.append(p)
+    sp = AgentSpawn(
+        positions=np.array(pts),
+        radii=np.full(n, 0.25),
+        vmax=rng.uniform(0.6, 1.6, n),
+        waypoints=rng.uniform(0.8, size - 0.8, (n, 4, 2)),
+        num_waypoints=np.full(n, 4),
+        waypoint_mode=np.full(n, WAYPOINT_LOOP),
+        kinds=np.zeros(n, dtype=np.int64),
+    )
+    return world, sp
+
+
+def assert_speed_cap_holds_exactly(model, n, size, steps, config=PLAIN):
+    """Every agent, every step: ``sqrt(vx² + vy²) ≤ vmax · vmax_factor``, no tolerance."""
+    from arena.crowd.base import CROWD_MODELS
+
+    world, sp = boxed_room(n, size)
+    sim = CrowdSimulator(CROWD_MODELS.build(model), config)
+    sim.reset(sp, world, np.random.default_rng(1))
+    over, worst = 0, 0.0
+    for _ in range(steps):
+        sim.step(NO_ROBOTS, 0.1)
+        s = sim.state
+        vx, vy = s.velocities[:, 0], s.velocities[:, 1]
+        excess = np.sqrt(vx * vx + vy * vy) - s.vmax * s.vmax_factor  # the integrator's formula
+        over += int((excess > 0.0).sum())
+        worst = max(worst, float(excess.max()))
+    assert over == 0, f"{over} agent-steps over the cap, by up to {worst:.3g} m/s"
+    assert worst > -1e-9  # someone walks at the cap: the test did reach it
+
+
+@pytest.mark.parametrize("model", ["orca", "rvo2", "pysocial"])
+def test_speed_cap_holds_exactly_in_a_dense_room_with_boxes(model):
+    # ORCA ignores walls, so the wall guard pushes people out of corners: those push-outs used to
+    # make 16 agent-steps here faster than the cap (by up to 1.1 mm/s), and rounding others.
+    assert_speed_cap_holds_exactly(model, 100, 10.0, 1000)
+
+
+@pytest.mark.slow
+def test_speed_cap_holds_exactly_for_orca_with_1000_people():
+    # The issue's size: 1,000 people, 3,000 steps (13 agent-steps over the cap before).
+    assert_speed_cap_holds_exactly("orca", 1000, 32.0, 3000)
+
+
+def test_cap_speed_is_exact_and_keeps_the_direction():
+    from arena.crowd.integrator import cap_speed
+
+    rng = np.random.default_rng(0)
+    v = rng.normal(size=(20_000, 2)) * 10.0 ** rng.uniform(-3, 3, (20_000, 1))
+    cap = np.abs(rng.normal(size=20_000)) * 10.0 ** rng.uniform(-3, 3, 20_000)
+    cap[:100] = 0.0
+    for (vx, vy), c in zip(v, cap, strict=True):
+        x, y = cap_speed(vx, vy, c)
+        norm = np.sqrt(x * x + y * y)
+        if np.sqrt(vx * vx + vy * vy) <= c:
+            assert (x, y) == (vx, vy)  # within the cap: untouched
+            continue
+        assert norm <= c
+        assert norm >= c * (1 - 1e-14)  # only rounding below the cap
+        assert abs(x * vy - y * vx) <= 1e-12 * abs(vx * vx + vy * vy)  # same direction
+        assert x * vx + y * vy >= 0.0
+
+
 def test_loop_mode_visits_waypoints_in_order_with_tolerant_switch():
     sp = spawn(n=1, k=3)
     _, states = run(sp, steps=2000)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import itertools
 import math
-import time
 
 import numpy as np
 import pytest
@@ -255,16 +254,16 @@ def test_plan_is_deterministic_and_leaves_grid_untouched() -> None:
 
 
 @pytest.mark.slow
-def test_large_grid_plans_fast() -> None:
+def test_large_grid_plans_corner_to_corner() -> None:
+    # (ms per plan on this map is a figure of benchmarks/planners_global.py, not a test)
     rng = np.random.default_rng(0)
     occ = rng.random((1000, 1000)) < 0.2
     occ[:5, :5] = occ[-5:, -5:] = False
     grid = OccupancyGrid.from_occupied(occ, 0.05)
     planner = _planner()
     start, goal = Pose2D(0.1, 0.1), Pose2D(49.9, 49.9)
-    planner.plan(grid, start, goal)  # compile / warm caches
-    t0 = time.perf_counter()
     path = planner.plan(grid, start, goal)
-    elapsed = time.perf_counter() - t0
-    assert len(path) >= 2
-    assert elapsed < 1.0
+    np.testing.assert_allclose(path[0], start.xy)
+    np.testing.assert_allclose(path[-1], goal.xy)
+    cells = grid.world_to_cell(path)
+    assert (grid.data[cells[:, 0], cells[:, 1]] == 0).all()  # waypoints on free cells

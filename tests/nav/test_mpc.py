@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -132,8 +131,9 @@ def test_deterministic_and_reset() -> None:
     np.testing.assert_array_equal(planner.compute(obs), a)
 
 
-def test_compute_time_per_cycle() -> None:
-    # A jackal-like 720-beam scan in a corridor; the average cycle must stay under 50 ms (CPU).
+def test_solver_succeeds_every_cycle_in_a_corridor() -> None:
+    # A jackal-like 720-beam scan in a corridor, 20 closed-loop cycles: the solver never falls
+    # back. (Compute time per cycle is a figure of benchmarks/planners.py, not a test.)
     planner = _mpc()
     angles = np.linspace(-2.356, 2.356, 720)
     ranges = 1.5 / np.maximum(np.abs(np.sin(angles)), 0.2)
@@ -141,14 +141,11 @@ def test_compute_time_per_cycle() -> None:
     pose, twist = np.zeros(3), np.array([0.5, 0.0, 0.0])
     path = _line(0, 10)
     planner.compute(_obs(pose, path, twist, lim, "diff_drive", ranges, angles))  # build
-    # CPU time of this process: wall time on a loaded shared test machine says little.
-    t0 = time.process_time()
     for _ in range(20):
         cmd = planner.compute(_obs(pose, path, twist, lim, "diff_drive", ranges, angles))
         pose, twist = _step(pose, cmd), cmd
-    per_cycle = (time.process_time() - t0) / 20
-    assert per_cycle < 0.05
     assert planner.failures == 0
+    assert pose[0] > 0.5  # it drove along the corridor
 
 
 def test_reaches_goals_in_an_empty_room(tmp_path: Path) -> None:

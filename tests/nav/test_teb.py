@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +12,6 @@ from arena.config import load_config
 from arena.core.types import Pose2D
 from arena.experiment import run_experiment
 from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation, TEBPlanner
-from arena.robots.limits import VelocityLimits
 from tests.nav.planner_kit import (
     BEHIND_ASIDE,
     CAR,
@@ -162,19 +160,6 @@ def test_dynamic_obstacle_moves_the_band() -> None:
     assert plain.band is not None and aware.band is not None
     assert np.max(np.abs(plain.band.poses[:, 1])) < 0.05
     assert np.max(np.abs(aware.band.poses[:, 1])) > 0.2
-
-
-def test_compute_time_per_cycle() -> None:
-    planner = _teb()
-    angles = np.linspace(-2.356, 2.356, 720)
-    ranges = 2.0 / np.maximum(np.abs(np.cos(angles)), 0.3)
-    lim = VelocityLimits(-2.0, 2.0, 0.0, 0.0, 4.0, 20.0, 0.0, 25.0)
-    obs = _obs([0, 0, 0], _line(0, 5), (0.5, 0, 0), lim, "diff_drive", ranges, angles)
-    planner.compute(obs)
-    t0 = time.process_time()
-    for _ in range(20):
-        planner.compute(obs)
-    assert (time.process_time() - t0) / 20 < 0.05
 
 
 def test_jackal_reaches_the_goal_in_an_empty_room(tmp_path: Path) -> None:

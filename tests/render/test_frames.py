@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -256,31 +254,3 @@ def test_margin_and_obstacles_outside_map_extend_the_view() -> None:
     assert ymin < -0.49
     assert ymax > 4.49
     assert r.height_px % 2 == 0
-
-
-@pytest.mark.slow
-def test_speed_30m_map_30_agents() -> None:
-    grid = OccupancyGrid.empty(30.0, 30.0, 0.05)
-    world = StaticWorld.build(grid, (Obstacle("t", "table", np.array([8.0, 20.0, 0.3]),
-                                              rectangle(1.6, 0.9)),))
-    spec = LidarSpec(angle_min=-np.pi, angle_max=np.pi, num_beams=360, range_max=8.0)
-    rng = np.random.default_rng(0)
-    r = FrameRenderer(world, lidar_specs=[spec], width_px=800, title="speed")
-    states = []
-    for k in range(30):
-        robots = RobotStates(("r",), ("jackal",), np.array([[5 + 0.1 * k, 5.0, 0.2]]),
-                             np.zeros((1, 3)), np.zeros((1, 3)), np.array([0.36]),
-                             (rectangle(0.5, 0.43),), (rng.uniform(0.5, 8.0, 360),))
-        agents = AgentStates(np.arange(30), rng.uniform(2, 28, (30, 2)), np.zeros((30, 2)),
-                             rng.uniform(-3, 3, 30), np.full(30, 0.3), np.arange(30) % 3,
-                             np.arange(30) % 4)
-        states.append(SimState(0.1 * k, k, robots, agents, Collisions.none(1)))
-    overlay = Overlay(paths=[np.array([[5.0, 5.0], [25.0, 25.0]])],
-                      goals=np.array([[25.0, 25.0, 0.5]]), text="outcome: running")
-    r.render(states[0], overlay)
-    times = []
-    for s in states:
-        t0 = time.perf_counter()
-        r.render(s, overlay)
-        times.append(time.perf_counter() - t0)
-    assert np.median(times) < 0.020

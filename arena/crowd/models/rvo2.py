@@ -7,13 +7,13 @@ handling (cut-off circles and legs, convex/non-convex vertices, "foreign" legs, 
 covered by earlier lines). The obstacle lines are hard: in the 3-D fallback linear program the
 agent may violate pedestrian lines, never obstacle lines.
 
-Walls come as segments (:func:`arena.crowd.walls.world_segments`: merged grid-wall runs and
-obstacle edges). Each segment becomes a 2-vertex RVO2 obstacle, which RVO2 supports: edges
-``a → b`` and ``b → a``, both vertices convex; an agent only sees the edge that has it on its
-right, so a segment blocks from both sides. Outlines are not merged into polygons: at a shared
-corner each segment contributes its own convex end vertex, so near inner corners the
-constraints can differ slightly from those of a closed polygon (whose reflex vertices RVO2
-marks non-convex).
+Obstacles are fed as RVO2 takes them (:func:`world_polygons`): every placed obstacle of the
+world as one closed counter-clockwise polygon (RVO2's ``addObstacle``: edges linked vertex to
+vertex, reflex vertices marked non-convex), and the map's walls (merged grid-wall runs, which
+have no polygon) as 2-vertex obstacles: edges ``a → b`` and ``b → a``, both vertices convex; an
+agent only sees the edge that has it on its right, so a segment blocks from both sides. A frame
+whose walls are not the episode's (a hand-built frame) has only segments to give: each becomes a
+2-vertex obstacle.
 
 The conversion then runs RVO2's ``processObstacles``: its obstacle k-d tree build splits every
 edge crossing a splitting edge's line into collinear pieces, and we do the same, so the edges
@@ -39,10 +39,48 @@ from arena.crowd.models.orca import (
     preferred_velocities,
 )
 from arena.crowd.state import CrowdState
-from arena.crowd.walls import world_segments
 from arena.sim.state import StaticWorld
 
-__all__ = ["Obstacles", "Rvo2Model", "Rvo2Params", "preferred_velocities"]
+__all__ = ["Obstacles", "Rvo2Model", "Rvo2Params", "preferred_velocities", "world_polygons"]
+
+
+def counter_clockwise(polygon: FloatArray) -> FloatArray:
+    """``(k, 2)`` vertices (m) as a closed RVO2 polygon: counter-clockwise, no repeated vertex.
+
+    Consecutive duplicates (a closing copy of the first vertex included) are dropped, as RVO2
+    would divide by their zero-length edge; a clockwise polygon is reversed. What is left may
+    have fewer than 3 vertices (2: a segment; fewer: nothing).
+    """
+    v = np.asarray(polygon, dtype=np.float64).reshape(-1, 2)
+    v = v[np.r_[True, np.any(v[1:] != v[:-1], axis=1)]] if len(v) else v
+    if len(v) > 1 and np.array_equal(v[0], v[-1]):
+        v = v[:-1]
+    if len(v) > 2:
+        x, y = v[:, 0], v[:, 1]
+        if np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y) < 0.0:  # 2 x signed area
+            v = v[::-1].copy()
+    return v
+
+
+def world_polygons(world: StaticWorld) -> list[FloatArray]:
+    """RVO2 obstacles of ``world``: the map's wall segments, then each placed obstacle.
+
+    Returns:
+        ``(2, 2)`` segments (m) of :func:`~arena.crowd.walls.grid_wall_segments` (zero-length
+        ones dropped), followed by one closed counter-clockwise ``(k, 2)`` polygon (m) per
+        obstacle of ``world.obstacles``, in order: what :meth:`Obstacles.from_polygons` (RVO2's
+        ``addObstacle`` for each) takes.
+    """
+    from arena.crowd.simulator import grid_walls  # (cached; the simulator imports the models)
+
+    ga, gb = grid_walls(world.grid)
+    keep = np.any(ga != gb, axis=1)
+    polys: list[FloatArray] = list(np.stack([ga[keep], gb[keep]], axis=1))
+    for ob in world.obstacles:
+        poly = counter_clockwise(ob.polygon)
+        if len(poly) >= 2:
+            polys.append(poly)
+    return polys
 
 
 class Rvo2Params(OrcaParams):
@@ -68,18 +106,36 @@ class Rvo2Model(OrcaModel):
         self._ob: Obstacles | None = None
 
     def reset(self, state: CrowdState, world: StaticWorld, rng: np.random.Generator) -> None:
-        """Convert the world's walls to RVO2 obstacles (once per episode; may take a moment)."""
-        a, b = world_segments(world)
-        self._convert(a, b, state)
+        """Convert the world to RVO2 obstacles (once per episode; may take a moment).
+
+        The placed obstacles become closed polygons, the map's walls segments
+        (:func:`world_polygons`); frames whose walls are the world's segments
+        (:func:`~arena.crowd.walls.world_segments`, as the simulator passes them) use them.
+        """
+        from arena.crowd.simulator import episode_segments
+
+        a, b = episode_segments(world)
+        self._convert(a, b, state, world_polygons(world))
 
     def _time_horizon_obst(self) -> float:
         return float(self.params.time_horizon_obst)
 
-    def _convert(self, a: FloatArray, b: FloatArray, state: CrowdState) -> None:
+    def _convert(
+        self,
+        a: FloatArray,
+        b: FloatArray,
+        state: CrowdState,
+        polygons: list[FloatArray] | None = None,
+    ) -> None:
+        """Obstacles for walls ``a → b`` ``(s, 2)``: ``polygons`` if given, else the segments."""
         # Grid cells about one obstacle range wide: a query then looks at 2 x 2 to 3 x 3 cells.
         vmax = float(np.max(state.vmax * state.vmax_factor, initial=1.0))
         reach = self.params.time_horizon_obst * vmax + float(np.max(state.radii, initial=0.3))
-        self._ob = Obstacles.from_segments(a, b, cell=max(reach, 1.0))
+        cell = max(reach, 1.0)
+        if polygons is None:
+            self._ob = Obstacles.from_segments(a, b, cell=cell)
+        else:
+            self._ob = Obstacles.from_polygons(polygons, cell=cell)
         self._walls = (a, b)
 
     def _obstacles(self, frame: CrowdFrame) -> Obstacles | None:
