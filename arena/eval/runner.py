@@ -40,6 +40,7 @@ from arena.eval.store import (
     commit_episode,
     completed,
     load_results,
+    load_rows,
     write_manifest,
 )
 from arena.tasks.suite import ContestFile, Suite, contestant_config, load_contest, load_suite
@@ -315,6 +316,7 @@ def run_benchmark(
     jobs = plan_jobs(suite_obj, contest_obj, base_cfg, contest_source=contest_src)
     if resume:
         check_manifest(run, settings)
+        load_rows(run)  # a corrupt row file: one line now, not after the run
     else:
         if (run / MANIFEST).exists():
             raise ArenaError(f"{run / MANIFEST}: {run} already holds a run; resume it instead")
