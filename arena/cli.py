@@ -442,7 +442,7 @@ def bench(
     from pydantic import ValidationError
 
     from arena.config.schema import ExperimentConfig
-    from arena.core.errors import from_validation_error
+    from arena.core.errors import ConfigError
     from arena.eval.runner import run_benchmark
     from arena.eval.store import load_results, read_manifest
 
@@ -464,8 +464,8 @@ def bench(
                          f"got {episode_timeout}")
     try:
         base_cfg = ExperimentConfig(seed=seed)
-    except ValidationError as e:
-        raise from_validation_error(e, source="--seed") from None
+    except ValidationError as e:  # the schema says what a seed must be
+        raise ConfigError(f"{e.errors()[0]['msg']} (got {seed})", source="--seed") from None
     if resume is not None and out is not None and resume.resolve() != out.resolve():
         raise ArenaError("give either --resume RUN_DIR or -o RUN_DIR, not two different folders")
     if out is not None and out.exists() and not out.is_dir():
