@@ -32,7 +32,7 @@ from pathlib import Path
 from typing import Any
 
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ArenaError
+from arena.core.errors import ArenaError, ConfigError
 from arena.eval.record import EpisodeRecord
 from arena.eval.store import (
     MANIFEST,
@@ -211,8 +211,6 @@ def check_scale(suite: Suite, source: str) -> None:
         ConfigError: every stage scaled to 0 episodes (naming the suite and the smallest scale
             that keeps one).
     """
-    from arena.core.errors import ConfigError
-
     scale = suite.scale_episodes
     counts = suite.episode_counts
     if sum(counts) == 0:

@@ -46,12 +46,15 @@ _PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
 
 def exit_description(code: int | None) -> str:
-    """``"exit code 3"``, ``"exit code -11: SIGSEGV"`` (a negative code is the killing signal)."""
+    """``"exit code 3"``, ``"exit code -11: SIGSEGV"``: a negative code is the killing signal."""
     if code is None:
         return "exit code unknown"
     if code < 0:
         with contextlib.suppress(ValueError):
-            return f"exit code {code}: {signal.Signals(-code).name}"
+            name = signal.Signals(-code).name
+            # SIGKILL is what the kernel's OOM killer sends
+            return f"exit code {code}: {name}" + (
+                " (out of memory?)" if name == "SIGKILL" else "")
     return f"exit code {code}"
 
 
@@ -176,26 +179,30 @@ def run_jobs(
         retire(w)
         on_result(error_result(job, message))
 
+    def dispatch(w: _Worker) -> None:
+        """Give an idle, ready worker the next job."""
+        while w.ready and not w.busy and queue:
+            job = queue.popleft()
+            try:
+                w.conn.send(job)
+            except OSError:  # it died while idle: the job goes to another worker
+                queue.appendleft(job)
+                return
+            except Exception as e:  # the job does not pickle
+                on_result(error_result(job, f"job not sent: {type(e).__name__}: {e}"))
+                continue
+            w.job = job
+            w.deadline = time.monotonic() + timeout if timeout is not None else float("inf")
+
     clean = False
     try:
         while queue or any(w.busy for w in pool):
             want = min(workers, sum(w.busy for w in pool) + len(queue))
             while len(pool) < want:
                 pool.append(start())
-            now = time.monotonic()
             for w in pool:
-                while w.ready and not w.busy and queue:
-                    job = queue.popleft()
-                    try:
-                        w.conn.send(job)
-                    except OSError:  # it died while idle: the job goes to another worker
-                        queue.appendleft(job)
-                        break
-                    except Exception as e:  # the job does not pickle
-                        on_result(error_result(job, f"job not sent: {type(e).__name__}: {e}"))
-                        continue
-                    w.job = job
-                    w.deadline = now + timeout if timeout is not None else float("inf")
+                dispatch(w)
+            now = time.monotonic()
             limits = [w.deadline if w.ready else w.started + STARTUP_TIMEOUT
                       for w in pool if w.busy or not w.ready]
             wait_s = max(0.0, min(limits) - now) if limits else None
@@ -217,6 +224,7 @@ def run_jobs(
                         continue
                     if msg is not None:
                         job, w.job = w.job, None
+                        dispatch(w)  # its next job runs while this result is committed
                         tag, value = msg
                         on_result(value if tag == "ok" else error_result(job, value))
                         continue
@@ -225,8 +233,10 @@ def run_jobs(
                     code = exit_description(w.process.exitcode)
                     if not w.ready:
                         retire(w)
-                        raise ArenaError(f"a benchmark worker process died while starting "
-                                         f"({code}); run with --workers 0 to see why")
+                        raise ArenaError(
+                            f"a benchmark worker process died while starting ({code}); a "
+                            f"script starting workers needs an `if __name__ == \"__main__\":` "
+                            f"guard; --workers 0 (workers=0) runs in this process and shows why")
                     if w.busy:
                         fail(w, f"worker died ({code})")
                     else:

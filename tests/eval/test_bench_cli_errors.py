@@ -232,7 +232,7 @@ def test_store_rows_are_checked_on_load(tmp_path: Path) -> None:
     row = {"contestant": "c", "local_planner": "x", "inter_planner": "bypass", "stage": "s",
            "episode": 0, "seed": None, "map": "m", "robot": "r", "outcome": "error",
            "time": math.nan, "path_length": math.nan, "collisions": 0, "wall_time": 0.0,
-           "error": "worker died (exit code -9: SIGKILL)", "m1": None}
+           "error": "worker died (exit code -9: SIGKILL (out of memory?))", "m1": None}
     commit_episode(tmp_path, row, None)  # an error row as the runner writes it loads
     t = load_results(tmp_path)
     assert t["error"].to_pylist() == [row["error"]] and t["seed"].to_pylist() == [None]

@@ -22,6 +22,7 @@ import pyarrow as pa
 import pytest
 
 from arena.config.schema import ExperimentConfig
+from arena.core.errors import ArenaError
 from arena.eval import workers
 from arena.eval.runner import run_benchmark
 from arena.eval.store import completed, load_results
@@ -287,5 +288,28 @@ def test_watchdog_alone_ends_an_orphaned_worker(tmp_path: Path) -> None:
 def test_exit_description() -> None:
     assert workers.exit_description(3) == "exit code 3"
     assert workers.exit_description(-11) == "exit code -11: SIGSEGV"
-    assert workers.exit_description(-9) == "exit code -9: SIGKILL"
+    assert workers.exit_description(-9) == "exit code -9: SIGKILL (out of memory?)"
     assert workers.exit_description(None) == "exit code unknown"
+
+
+def _pool(jobs: list[Any], fn: Any, **kwargs: Any) -> list[Any]:
+    results: list[Any] = []
+    workers.run_jobs(jobs, fn, results.append, lambda job, msg: ("error", job, msg), **kwargs)
+    return results
+
+
+def test_pool_turns_a_raising_job_or_one_that_does_not_pickle_into_its_error() -> None:
+    results = _pool([4.0, -1.0, lambda: 0, 9.0], math.sqrt, workers=1)
+    assert results[:1] + results[2:] == [2.0, ("error", -1.0, "ValueError: math domain error"),
+                                         3.0]
+    assert results[1][0] == "error" and results[1][2].startswith("job not sent: ")
+    assert not mp.active_children()
+
+
+def test_pool_stops_when_a_worker_cannot_start(monkeypatch: pytest.MonkeyPatch) -> None:
+    with pytest.raises(ArenaError, match=r"died while starting \(exit code 5\).*workers 0"):
+        _pool([1.0], math.sqrt, workers=1, initializer=os._exit, initargs=(5,))
+    monkeypatch.setattr(workers, "STARTUP_TIMEOUT", 0.5)
+    with pytest.raises(ArenaError, match=r"did not start within 0\.5 s"):
+        _pool([1.0], math.sqrt, workers=1, initializer=time.sleep, initargs=(3600,))
+    assert not mp.active_children()
