@@ -423,10 +423,11 @@ def bench(
         bool, typer.Option("--report/--no-report", help="then write the HTML report (RUN/report)")
     ] = False,
     episode_timeout: Annotated[
-        float, typer.Option("--episode-timeout", metavar="SECONDS",
-                            help="wall-clock limit of one episode: past it, its worker is "
-                                 "killed and the episode ends as error (0: no limit)")
-    ] = 600.0,
+        float | None,
+        typer.Option("--episode-timeout", metavar="SECONDS",
+                     help="wall-clock limit of one episode: past it, its worker is killed and "
+                          "the episode ends as error (0: no limit) \\[default: 600]"),
+    ] = None,
 ) -> None:
     """Benchmark: every contestant on every episode of a suite; resumable, parallel.
 
@@ -459,9 +460,12 @@ def bench(
     if workers < (1 if backend is BenchBackend.ray else 0):
         raise ArenaError(f"--workers: expected an integer >= "
                          f"{1 if backend is BenchBackend.ray else 0}, got {workers}")
-    if not (math.isfinite(episode_timeout) and episode_timeout >= 0):
-        raise ArenaError(f"--episode-timeout: expected seconds >= 0 (0: no limit), "
-                         f"got {episode_timeout}")
+    limit = {}  # the runner's default unless given
+    if episode_timeout is not None:
+        if not (math.isfinite(episode_timeout) and episode_timeout >= 0):
+            raise ArenaError(f"--episode-timeout: expected seconds >= 0 (0: no limit), "
+                             f"got {episode_timeout}")
+        limit["episode_timeout"] = episode_timeout or None
     try:
         base_cfg = ExperimentConfig(seed=seed)
     except ValidationError as e:  # the schema says what a seed must be
@@ -481,7 +485,7 @@ def bench(
         run = run_benchmark(
             suite, contest, run_dir, base_cfg=base_cfg, workers=workers,
             resume=resume is not None, scale=scale, progress=progress, backend=backend.value,
-            ray_address=ray_address, episode_timeout=episode_timeout or None,
+            ray_address=ray_address, **limit,
         )
     _print_bench_tables(load_results(run), f"{suite} · {Path(contest).stem} · seed {seed}")
     console.print(f"run folder: {run}")
