@@ -526,7 +526,11 @@ def run_experiment(
     # Draw the first episode before writing anything: a bad map or task fails with no output.
     first = generator.episode(0)
     out = Path(out_dir or cfg.output.dir or default_output_dir(cfg))
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:  # a file of that name, /dev/null, a name too long, no permission
+        raise ArenaError(f"{out}: cannot create the output folder (output.dir, -o): "
+                         f"{e.strerror or e}") from None
     (out / "config.yaml").write_text(yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False))
     results: list[EpisodeResult] = []
     for i in range(n_episodes):

@@ -3,13 +3,14 @@
 import json
 import math
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from arena import cli
 from arena.config import load_config
-from arena.core.errors import ConfigError
+from arena.core.errors import ArenaError, ConfigError
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.base import CROWD_MODELS
 from arena.experiment import make_episode, run_episode, run_experiment
@@ -233,3 +234,13 @@ def test_cli_run_logs_a_raising_planner_in_one_line(tmp_path, monkeypatch, capsy
     assert all("RuntimeError: boom from the test planner" in line for line in lines)
     assert "Traceback" not in out + err
     assert (tmp_path / "summary.csv").read_text().count("\n") == 3
+
+
+@pytest.mark.parametrize("where", ["file", "dev_null", "long_name"])
+def test_output_folder_that_cannot_be_made_is_a_one_line_error(where, tmp_path):
+    target = {"file": tmp_path / "taken", "dev_null": "/dev/null",
+              "long_name": tmp_path / ("x" * 300)}[where]
+    if where == "file":
+        target.write_text("mine")
+    with pytest.raises(ArenaError, match=r"cannot create the output folder \(output\.dir, -o\)"):
+        run_experiment(load_config(None, FAST), Path(target))
