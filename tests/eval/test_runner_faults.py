@@ -257,23 +257,22 @@ def test_workers_exit_with_a_killed_parent(sig: signal.Signals, fault_plugin: Pa
 @pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="needs Linux /proc")
 def test_watchdog_alone_ends_an_orphaned_worker(tmp_path: Path) -> None:
     """The portable fallback (no PR_SET_PDEATHSIG): the worker's watchdog sees the new ppid."""
+    armed = tmp_path / "armed"  # the grandchild writes its pid there once its watchdog runs
     grandchild = (
-        "import os, time; from arena.eval import workers; "
-        "workers._exit_with_parent(os.getppid(), pdeathsig=False); print('armed', flush=True); "
-        "time.sleep(3600)"
+        "import os, time; from pathlib import Path; from arena.eval import workers; "
+        "workers._exit_with_parent(os.getppid(), pdeathsig=False); "
+        f"Path({str(armed)!r}).write_text(str(os.getpid())); time.sleep(3600)"
     )
     middle = (
         "import subprocess, sys, time; "
-        f"p = subprocess.Popen([sys.executable, '-c', {grandchild!r}], stdout=sys.stdout); "
-        "print(p.pid, flush=True); time.sleep(3600)"
+        f"subprocess.Popen([sys.executable, '-c', {grandchild!r}]); time.sleep(3600)"
     )
-    proc = subprocess.Popen([sys.executable, "-c", middle], cwd=ROOT, stdout=subprocess.PIPE,
-                            text=True)
+    proc = subprocess.Popen([sys.executable, "-c", middle], cwd=ROOT)
     pid = 0
     try:
-        assert proc.stdout is not None
-        pid = int(proc.stdout.readline())
-        assert proc.stdout.readline().strip() == "armed"
+        _wait_for(lambda: (armed.is_file() and armed.read_text() != "")
+                  or proc.poll() is not None, "the grandchild to arm its watchdog")
+        pid = int(armed.read_text())
         proc.kill()
         proc.wait(BOUND_S)
         _wait_for(lambda: not _alive(pid), "the orphaned worker to exit", bound=30)
