@@ -25,7 +25,15 @@ from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
-from pydantic import BaseModel, ConfigDict, Field, StrictInt, StrictStr, ValidationError
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+)
 
 from arena import __version__
 from arena.core.errors import ArenaError, ConfigError, from_validation_error
@@ -120,7 +128,7 @@ class RunManifest(BaseModel):
     suite: StrictStr = Field(min_length=1)
     contest: StrictStr = Field(min_length=1)
     seed: StrictInt = Field(ge=0)
-    scale: float = Field(gt=0)
+    scale: StrictFloat = Field(gt=0)
 
 
 def read_manifest(run: str | Path) -> dict[str, Any]:

@@ -134,6 +134,7 @@ def test_out_is_a_file(files: tuple[Path, Path], tmp_path: Path,
     ({"seed": None}, ["run.json: seed: Input should be a valid integer"]),
     ({"scale": math.nan}, ["run.json: scale:", "finite"]),
     ({"scale": 0}, ["run.json: scale: Input should be greater than 0"]),
+    ({"scale": "1"}, ["run.json: scale: Input should be a valid number"]),
     ({"contest": 3}, ["run.json: contest: Input should be a valid string"]),
     ({"seed": "DROP"}, ["run.json: seed: required key is missing"]),
 ])
