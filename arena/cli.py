@@ -465,6 +465,9 @@ def bench(
         if not (math.isfinite(episode_timeout) and episode_timeout >= 0):
             raise ArenaError(f"--episode-timeout: expected seconds >= 0 (0: no limit), "
                              f"got {episode_timeout}")
+        if workers == 0 and episode_timeout and backend is BenchBackend.process:
+            raise ArenaError("--episode-timeout: an episode in this process (--workers 0) "
+                             "cannot be stopped; use --workers 1 or more")
         limit["episode_timeout"] = episode_timeout or None
     try:
         base_cfg = ExperimentConfig(seed=seed)

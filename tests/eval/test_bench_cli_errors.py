@@ -98,6 +98,8 @@ def _one_error_line(code: int, err: str, *fragments: str) -> None:
     (["--episode-timeout", "-1"], ["--episode-timeout: expected seconds >= 0"]),
     (["--episode-timeout", "nan"], ["--episode-timeout: expected seconds >= 0"]),
     (["--workers", "-1"], ["--workers: expected an integer >= 0, got -1"]),
+    (["--workers", "0", "--episode-timeout", "5"], ["--episode-timeout: an episode in this "
+                                                    "process (--workers 0) cannot be stopped"]),
     (["--workers", "0", "--backend", "ray"], ["--workers: expected an integer >= 1, got 0"]),
 ])
 def test_bad_options(args: list[str], fragments: list[str], files: tuple[Path, Path],
