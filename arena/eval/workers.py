@@ -99,7 +99,8 @@ def _worker_main(conn: Connection, parent_pid: int, fn: Callable[[Any], Any],
         try:
             reply: tuple[str, Any] = ("ok", fn(job))
         except Exception as e:  # fn should not raise; if it does, the job fails, not the worker
-            reply = ("raised", f"{type(e).__name__}: {e}")
+            first = (str(e).strip().splitlines() or [""])[0]
+            reply = ("raised", f"{type(e).__name__}: {first}".rstrip(": "))
         conn.send(reply)
 
 
