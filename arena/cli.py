@@ -90,6 +90,8 @@ def run(
     line: ``goal X Y [TH]`` (new goal), ``teleport X Y [TH]`` (move the robot), ``reset`` (end
     the episode), ``quit`` (stop reading); ``robot=I`` picks another robot.
     """
+    from rich.markup import escape
+
     from arena.config import load_config
     from arena.experiment import run_experiment, run_name
 
@@ -150,6 +152,8 @@ def run(
         console.print(
             f"  episode {res.index}: [{colour}]{res.outcome}[/] after {res.time:.1f} s, "
             f"{res.path_length:.1f} m, {res.collisions} collision(s) ({res.wall_time:.1f} s wall)"
+            + (f": {escape(res.error)}" if res.error else ""),
+            highlight=False, soft_wrap=True,  # one line, however long the message
         )
         table.add_row(
             str(res.index),
@@ -444,7 +448,8 @@ def bench(
         ),
     ] = None,
     workers: Annotated[
-        int, typer.Option("--workers", "-j", help="worker processes (ray: tasks at once)")
+        int, typer.Option("--workers", "-j", help="worker processes (0: in this process, for "
+                          "debugging: no fault isolation); ray: tasks at once")
     ] = 1,
     backend: Annotated[
         BenchBackend,
@@ -476,38 +481,75 @@ def bench(
         bool, typer.Option("--report/--no-report", help="then write the HTML report (RUN/report)")
     ] = False,
     plugin: PluginOption = None,
+    episode_timeout: Annotated[
+        float | None,
+        typer.Option("--episode-timeout", metavar="SECONDS",
+                     help="wall-clock limit of one episode: past it, its worker is killed and "
+                          "the episode ends as error (0: no limit) \\[default: 600]"),
+    ] = None,
 ) -> None:
     """Benchmark: every contestant on every episode of a suite; resumable, parallel.
 
     Results land in the run folder (``episodes/<contestant>/<stage>/<episode>.parquet|json``,
-    ``run.json``); a killed run continues with ``--resume RUN_DIR``.
+    ``run.json``); a killed run continues with ``--resume RUN_DIR``. An episode whose worker
+    dies (a crashing planner) or that runs past ``--episode-timeout`` ends as ``error``; the
+    run goes on.
     """
+    import math
+    import warnings
     from datetime import datetime
 
+    from pydantic import ValidationError
+
     from arena.config.schema import ExperimentConfig
+    from arena.core.errors import ConfigError
     from arena.eval.runner import run_benchmark
     from arena.eval.store import load_results, read_manifest
 
     _load_plugins(plugin)
     if resume is not None:
-        manifest = read_manifest(resume)
-        contest = contest if contest is not None else str(manifest.get("contest", "basic"))
-        seed = seed if seed is not None else int(manifest.get("seed", 0))
-        scale = scale if scale is not None else float(manifest.get("scale", 1.0))
+        manifest = read_manifest(resume)  # checked: a bad field is a one-line error
+        contest = contest if contest is not None else str(manifest["contest"])
+        seed = seed if seed is not None else int(manifest["seed"])
+        scale = scale if scale is not None else float(manifest["scale"])
     contest = contest if contest is not None else "basic"
     seed = seed if seed is not None else 0
     scale = scale if scale is not None else 1.0
+    if not (math.isfinite(scale) and scale > 0):
+        raise ArenaError(f"--scale: expected a finite number > 0, got {scale}")
+    if workers < (1 if backend is BenchBackend.ray else 0):
+        raise ArenaError(f"--workers: expected an integer >= "
+                         f"{1 if backend is BenchBackend.ray else 0}, got {workers}")
+    limit = {}  # the runner's default unless given
+    if episode_timeout is not None:
+        if not (math.isfinite(episode_timeout) and episode_timeout >= 0):
+            raise ArenaError(f"--episode-timeout: expected seconds >= 0 (0: no limit), "
+                             f"got {episode_timeout}")
+        if workers == 0 and episode_timeout and backend is BenchBackend.process:
+            raise ArenaError("--episode-timeout: an episode in this process (--workers 0) "
+                             "cannot be stopped; use --workers 1 or more")
+        limit["episode_timeout"] = episode_timeout or None
+    try:
+        base_cfg = ExperimentConfig(seed=seed)
+    except ValidationError as e:  # the schema says what a seed must be
+        raise ConfigError(f"{e.errors()[0]['msg']} (got {seed})", source="--seed") from None
     if resume is not None and out is not None and resume.resolve() != out.resolve():
         raise ArenaError("give either --resume RUN_DIR or -o RUN_DIR, not two different folders")
+    if out is not None and out.exists() and not out.is_dir():
+        raise ArenaError(f"-o/--out: {out} is a file; expected a run folder (new or empty)")
     run_dir = resume or out
     if run_dir is None:
         name = Path(contest).stem
         run_dir = Path("runs") / f"bench_{name}_{datetime.now().strftime('%y-%m-%d_%H-%M-%S')}"
-    run = run_benchmark(
-        suite, contest, run_dir, base_cfg=ExperimentConfig(seed=seed), workers=workers,
-        resume=resume is not None, scale=scale, progress=progress, backend=backend.value,
-        ray_address=ray_address,
-    )
+    with warnings.catch_warnings():
+        # one line per warning (a stage the scale drops ...), not Python's two with a source line
+        warnings.showwarning = lambda message, *args, **kwargs: err_console.print(
+            f"[yellow]warning:[/] {message}", highlight=False, soft_wrap=True)
+        run = run_benchmark(
+            suite, contest, run_dir, base_cfg=base_cfg, workers=workers,
+            resume=resume is not None, scale=scale, progress=progress, backend=backend.value,
+            ray_address=ray_address, **limit,
+        )
     _print_bench_tables(load_results(run), f"{suite} · {Path(contest).stem} · seed {seed}")
     console.print(f"run folder: {run}")
     if report:

@@ -26,6 +26,7 @@ import json
 import math
 import re
 import time
+import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from datetime import datetime
@@ -95,6 +96,37 @@ class EpisodeResult:
             f.name: getattr(self, f.name) for f in fields(self)
             if f.name not in ("record", "metrics")
         }
+
+
+def describe_exception(e: BaseException) -> str:
+    """One line for a failed episode: ``"<Type>: message"`` (its first line).
+
+    Anything but an :class:`ArenaError` (a plugin's bug) gets ``" (at file.py:line)"``, where it
+    was raised.
+    """
+    lines = str(e).strip().splitlines()
+    text = f"{type(e).__name__}: {lines[0] if lines else ''}".rstrip(": ")
+    if not isinstance(e, ArenaError):
+        tb = traceback.extract_tb(e.__traceback__)
+        if tb:
+            text += f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})"
+    return text
+
+
+def failed_result(cfg: ExperimentConfig, episode: Episode, error: str,
+                  wall_time: float = 0.0) -> EpisodeResult:
+    """The result of an episode that failed before it could be simulated (outcome ``error``).
+
+    Figures are NaN (time, path length, goal distance) or zero (steps, collisions); no record.
+    """
+    spawn = episode.robots[0]
+    return EpisodeResult(
+        index=episode.index, seed=episode.seed, map=episode.map_name, robot=spawn.model.name,
+        stage=episode.label, outcome=Outcome.ERROR.value, time=math.nan, steps=0,
+        path_length=math.nan, collisions=0, start=spawn.start.as_array().tolist(),
+        goal=spawn.goal.as_array().tolist(), final_goal_distance=math.nan, wall_time=wall_time,
+        error=error,
+    )
 
 
 def make_episode(
@@ -354,8 +386,8 @@ def run_episode(
             touching = hit
     except PlanningError as e:
         outcome, error = Outcome.PLANNER_FAILURE, f"{type(e).__name__}: {e}"
-    except ArenaError as e:
-        outcome, error = Outcome.ERROR, f"{type(e).__name__}: {e}"
+    except Exception as e:  # a faulty plugin (any exception) costs this episode, not the run
+        outcome, error = Outcome.ERROR, describe_exception(e)
 
     rec.event(state.time, "outcome", outcome.value)
     record = rec.finish(
@@ -534,30 +566,41 @@ def run_experiment(
     # Draw the first episode before writing anything: a bad map or task fails with no output.
     first = generator.episode(0)
     out = Path(out_dir or cfg.output.dir or default_output_dir(cfg))
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as e:  # a file of that name, /dev/null, a name too long, no permission
+        raise ArenaError(f"{out}: cannot create the output folder (output.dir, -o): "
+                         f"{e.strerror or e}") from None
     (out / "config.yaml").write_text(yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False))
-    results = []
+    results: list[EpisodeResult] = []
     for i in range(n_episodes):
         episode = first if i == 0 else generator.episode(i)
         video = cfg.output.video and i < cfg.output.video_episodes
-        res = run_episode(
-            cfg,
-            episode,
-            backend,
-            out / f"episode_{i:03d}",
-            video=video,
-            runtime=generator.runtime(episode),
-            realtime=realtime,
-            on_step=None if on_step is None else functools.partial(on_step, i),
-        )
+        t0 = time.perf_counter()
+        try:
+            res = run_episode(
+                cfg,
+                episode,
+                backend,
+                out / f"episode_{i:03d}",
+                video=video,
+                runtime=generator.runtime(episode),
+                realtime=realtime,
+                on_step=None if on_step is None else functools.partial(on_step, i),
+            )
+        except Exception as e:  # raised outside the step loop (a planner's constructor ...)
+            res = failed_result(cfg, episode, describe_exception(e), time.perf_counter() - t0)
         res.metrics, problem = episode_metrics(res.record)
         if problem:
             res.error = f"{res.error}; {problem}" if res.error else problem
         generator.feedback(i, res.outcome)
         results.append(res)
+        # after every episode: a run stopped later keeps the rows of the finished ones
+        _write_summary(out / "summary.csv", results)
         if on_episode:
             on_episode(res)
-    _write_summary(out / "summary.csv", results)
+    if not results:
+        _write_summary(out / "summary.csv", results)
     return out, results
 
 

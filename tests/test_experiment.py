@@ -1,16 +1,22 @@
 """The experiment loop end to end: determinism, outcomes, files."""
 
 import json
+import math
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from arena import cli
 from arena.config import load_config
-from arena.core.errors import ConfigError
+from arena.core.errors import ArenaError, ConfigError
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.base import CROWD_MODELS
 from arena.experiment import make_episode, run_episode, run_experiment
 from arena.maps.grid import OccupancyGrid
+from arena.nav.local_planners.base import LOCAL_PLANNERS
+from arena.nav.local_planners.pure_pursuit import PurePursuitPlanner
 from arena.robots.presets import load_robot
 from arena.sim.native2d import Native2DBackend
 from tests.conftest import make_episode as hand_episode
@@ -163,3 +169,78 @@ def test_teleport_moves_the_robot_at_rest():
     t = backend.teleport(0, Pose2D(5.0, 5.0, 1.0))
     assert np.allclose(t.robots.poses[0], [5.0, 5.0, 1.0]) and np.allclose(t.robots.twists[0], 0)
     assert t.time == s.time and not t.collisions.any[0]
+
+
+class _BoomPlanner(PurePursuitPlanner):
+    """Raises a plain Python exception after half a simulated second."""
+
+    def compute(self, obs):  # type: ignore[no-untyped-def]
+        if obs.time > 0.5:
+            raise RuntimeError("boom from the test planner")
+        return super().compute(obs)
+
+
+class _BadInitPlanner(PurePursuitPlanner):
+    """Raises while it is built (before the episode's first step)."""
+
+    def __init__(self, params=None):  # type: ignore[no-untyped-def]
+        raise ValueError("cannot build the test planner")
+
+
+@pytest.fixture
+def raising_planners(monkeypatch):
+    """Register the raising planners for one test only."""
+    monkeypatch.setattr(LOCAL_PLANNERS, "_entries", dict(LOCAL_PLANNERS._entries))
+    LOCAL_PLANNERS.add("test_experiment_boom", _BoomPlanner)
+    LOCAL_PLANNERS.add("test_experiment_bad_init", _BadInitPlanner)
+
+
+@pytest.mark.usefixtures("raising_planners")
+@pytest.mark.parametrize(("planner", "error"), [
+    ("test_experiment_boom", "RuntimeError: boom from the test planner (at test_experiment.py:"),
+    ("test_experiment_bad_init", "ValueError: cannot build the test planner (at "),
+])
+def test_a_raising_planner_costs_its_episode_only(planner, error, tmp_path):
+    cfg = load_config(None, [*FAST, "episodes=3", f"navigation.local_planner.type={planner}"])
+    rows_seen = []
+
+    def seen(res):  # summary.csv already holds every finished episode
+        rows_seen.append((tmp_path / "summary.csv").read_text().count("\n") - 1)
+
+    _, results = run_experiment(cfg, tmp_path, on_episode=seen)
+    assert [r.outcome for r in results] == ["error"] * 3  # every episode ran
+    assert all(r.error.startswith(error) for r in results)
+    assert rows_seen == [1, 2, 3]
+    lines = (tmp_path / "summary.csv").read_text().splitlines()
+    assert len(lines) == 4 and all(",error," in line for line in lines[1:])
+    if planner == "test_experiment_boom":  # the steps before the fault are recorded
+        assert results[0].record is not None and results[0].time > 0.5
+        assert (tmp_path / "episode_000" / "episode.parquet").is_file()
+    else:
+        assert results[0].record is None and math.isnan(results[0].time)
+
+
+@pytest.mark.usefixtures("raising_planners")
+def test_cli_run_logs_a_raising_planner_in_one_line(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(sys, "argv", ["arena", "run", *FAST, "-o", str(tmp_path),
+                                      "navigation.local_planner.type=test_experiment_boom"])
+    monkeypatch.setattr(cli.console, "width", 300)
+    with pytest.raises(SystemExit) as ok:
+        cli.main()
+    out, err = capsys.readouterr()
+    assert ok.value.code in (0, None), err
+    lines = [line for line in out.splitlines() if "episode " in line and "error" in line]
+    assert len(lines) == 2, out
+    assert all("RuntimeError: boom from the test planner" in line for line in lines)
+    assert "Traceback" not in out + err
+    assert (tmp_path / "summary.csv").read_text().count("\n") == 3
+
+
+@pytest.mark.parametrize("where", ["file", "dev_null", "long_name"])
+def test_output_folder_that_cannot_be_made_is_a_one_line_error(where, tmp_path):
+    target = {"file": tmp_path / "taken", "dev_null": "/dev/null",
+              "long_name": tmp_path / ("x" * 300)}[where]
+    if where == "file":
+        target.write_text("mine")
+    with pytest.raises(ArenaError, match=r"cannot create the output folder \(output\.dir, -o\)"):
+        run_experiment(load_config(None, FAST), Path(target))

@@ -12,7 +12,11 @@ Metrics named like a figure of :class:`~arena.experiment.EpisodeResult` (``path_
 teleport jumps); they agree with the metric on episodes without teleports.
 
 An episode whose planner raises, returns NaN or otherwise fails ends as ``error`` with the
-message in ``error``; the run goes on.
+message in ``error``; the run goes on. Each episode runs in a worker process
+(:mod:`arena.eval.workers`), so an episode whose worker dies (a segfault, ``os._exit``, the OOM
+killer) or that runs past the wall-clock limit ``episode_timeout`` ends as ``error`` too
+("worker died (exit code -11: SIGSEGV)", "wall-clock limit 600 s exceeded") and costs nothing
+else: the worker is replaced, the rows already committed stay, the run goes on.
 """
 
 from __future__ import annotations
@@ -20,16 +24,15 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-import traceback
+import warnings
 from collections.abc import Callable, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ArenaError
+from arena.core.errors import ArenaError, ConfigError
 from arena.eval.record import EpisodeRecord
 from arena.eval.store import (
     MANIFEST,
@@ -37,12 +40,16 @@ from arena.eval.store import (
     commit_episode,
     completed,
     load_results,
+    load_rows,
     write_manifest,
 )
 from arena.tasks.suite import ContestFile, Suite, contestant_config, load_contest, load_suite
 
 #: ``progress`` callback: ``(done, total, row)`` after each committed job.
 ProgressFn = Callable[[int, int, dict[str, Any]], None]
+#: Default wall-clock limit of one episode (s): far above what a planner needs for the packaged
+#: suites' longest episodes, short enough that a hung planner costs minutes, not the night.
+DEFAULT_EPISODE_TIMEOUT = 600.0
 
 
 @dataclass(frozen=True)
@@ -157,7 +164,7 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
 
     import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
     from arena.eval.metrics import compute_metrics
-    from arena.experiment import run_episode
+    from arena.experiment import describe_exception, run_episode
     from arena.sim.backend import BACKENDS
 
     t0 = time.perf_counter()
@@ -183,20 +190,39 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
                 )
     except Exception as e:
         row["outcome"] = "error"
-        row["error"] = f"{type(e).__name__}: {e}"
-        tb = traceback.extract_tb(e.__traceback__)
-        if tb:
-            row["error"] += f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})"
+        row["error"] = describe_exception(e)
     for name, value in metrics.items():  # path_length, collisions: run_episode's figures win
         row.setdefault(name, value)
     row["wall_time"] = time.perf_counter() - t0
     return row, record
 
 
-def _mp_context() -> Any:
-    import multiprocessing as mp
+def _warm_up() -> None:
+    """A fresh worker's imports (registries, simulator, metrics), before its first job."""
+    import arena.eval.metrics
+    import arena.experiment
+    import arena.plugins  # noqa: F401
 
-    return mp.get_context("spawn")
+
+def check_scale(suite: Suite, source: str) -> None:
+    """Warn once per stage that ``scale_episodes`` drops; raise when no episode is left.
+
+    Raises:
+        ConfigError: every stage scaled to 0 episodes (naming the suite and the smallest scale
+            that keeps one).
+    """
+    scale = suite.scale_episodes
+    counts = suite.episode_counts
+    if sum(counts) == 0:
+        planned = [st.episodes for st in suite.stages if st.episodes > 0]
+        hint = f"; a scale >= {1 / max(planned):.3g} keeps one" if planned else ""
+        raise ConfigError(f"scale {scale:g} leaves no episode in any stage{hint}",
+                          source=source)
+    for st, n in zip(suite.stages, counts, strict=True):
+        if n == 0 and st.episodes > 0:
+            warnings.warn(f"{source}: scale {scale:g} drops stage {st.name!r} "
+                          f"({st.episodes} episode(s) x {scale:g} < 1)", UserWarning,
+                          stacklevel=3)
 
 
 def run_benchmark(
@@ -211,6 +237,7 @@ def run_benchmark(
     progress: bool | ProgressFn | None = None,
     backend: str = "process",
     ray_address: str | None = None,
+    episode_timeout: float | None = DEFAULT_EPISODE_TIMEOUT,
 ) -> Path:
     """Run (or resume) a benchmark into ``run_dir``; return the run folder.
 
@@ -220,8 +247,10 @@ def run_benchmark(
         contest: packaged contest name, contest file or a loaded :class:`ContestFile`.
         run_dir: the run folder (created); results land as in :mod:`arena.eval.store`.
         base_cfg: the experiment every stage derives from (its ``seed`` is the run seed).
-        workers: parallel worker processes (1 = in this process); with ``backend="ray"``, the
-            number of tasks run at once (and the CPUs of the local Ray it starts).
+        workers: worker processes running the episodes; ``0`` runs them in this process
+            (for debugging: no fault isolation, no wall-clock limit, but plugins registered at
+            run time in this process are seen). With ``backend="ray"``, the number of tasks
+            run at once (and the CPUs of the local Ray it starts).
         resume: continue the run in ``run_dir``: skip its committed episodes. The suite,
             contest, seed and scale must be the run's.
         scale: factor on every stage's episode count.
@@ -231,14 +260,28 @@ def run_benchmark(
             backend is not part of the run's settings: a run resumes with either.
         ray_address: with ``backend="ray"``: ``None`` starts a local Ray (shut down at the end)
             unless one is already initialized; ``"auto"`` or an address connects to a cluster.
+        episode_timeout: wall-clock limit of one episode (s), ``None`` for none: an episode
+            past it has its worker (ray: its task) killed and ends as ``error``. Like
+            ``workers`` and ``backend`` it is not part of the run's settings.
+
+    Warns:
+        UserWarning: once per stage that ``scale`` drops to 0 episodes.
 
     Raises:
-        ArenaError: a bad suite/contest, ``run_dir`` holding a run without ``resume``, a resume
-            with different settings, or ``backend="ray"`` without ray installed.
+        ArenaError: a bad suite/contest, a scale that leaves no episode, ``run_dir`` holding a
+            run without ``resume`` (or being a file), a resume with different settings or a
+            corrupt manifest, or ``backend="ray"`` without ray installed.
     """
     base_cfg = base_cfg or ExperimentConfig()
-    if workers < 1:
-        raise ArenaError(f"workers must be >= 1, got {workers}")
+    if workers < (1 if backend == "ray" else 0):
+        raise ArenaError(f"workers must be >= {1 if backend == 'ray' else 0}, got {workers}")
+    if episode_timeout is not None and not (
+        math.isfinite(episode_timeout) and episode_timeout > 0
+    ):
+        raise ArenaError(f"episode_timeout must be a finite number of seconds > 0 (or None for "
+                         f"no limit), got {episode_timeout}")
+    if not (math.isfinite(scale) and scale > 0):
+        raise ArenaError(f"scale must be a finite number > 0, got {scale}")
     import arena.plugins  # noqa: F401  (fills the registries: map sources, planners, ...)
 
     if backend not in ("process", "ray"):
@@ -267,25 +310,34 @@ def run_benchmark(
         "suite": suite_src, "contest": contest_src, "seed": int(base_cfg.seed),
         "scale": float(scale),
     }
+    check_scale(suite_obj, suite_src)
     jobs = plan_jobs(suite_obj, contest_obj, base_cfg, contest_source=contest_src)
     if resume:
         check_manifest(run, settings)
+        load_rows(run)  # a corrupt row file: one line now, not after the run
     else:
         if (run / MANIFEST).exists():
             raise ArenaError(f"{run / MANIFEST}: {run} already holds a run; resume it instead")
-        run.mkdir(parents=True, exist_ok=True)
-        write_manifest(run, suite=suite_src, contest=contest_src, seed=int(base_cfg.seed),
-                       scale=float(scale))
+        if run.exists() and not run.is_dir():
+            raise ArenaError(f"{run}: is a file; the run folder must be a folder (new or empty)")
+        try:
+            run.mkdir(parents=True, exist_ok=True)
+            write_manifest(run, suite=suite_src, contest=contest_src, seed=int(base_cfg.seed),
+                           scale=float(scale))
+        except OSError as e:
+            raise ArenaError(f"{run}: cannot create the run folder ({e.strerror or e})") from None
     done = completed(run)
     todo = [j for j in jobs if j.key not in done]
     total = len(jobs)
-    _execute(run, todo, total, total - len(todo), workers, progress, backend, ray_address)
+    _execute(run, todo, total, total - len(todo), workers, progress, backend, ray_address,
+             episode_timeout)
     return run
 
 
 def _execute(
     run: Path, todo: Sequence[Job], total: int, start: int, workers: int,
     progress: bool | ProgressFn | None, backend: str, ray_address: str | None = None,
+    episode_timeout: float | None = None,
 ) -> None:
     bar: Any = None
     task: Any = None
@@ -311,7 +363,11 @@ def _execute(
     def commit(result: tuple[dict[str, Any], EpisodeRecord | None]) -> None:
         nonlocal count
         row, record = result
-        commit_episode(run, row, record)
+        try:
+            commit_episode(run, row, record)
+        except OSError as e:  # disk full, folder removed: the run cannot go on
+            raise ArenaError(f"{run}: cannot write the results of {row['contestant']}/"
+                             f"{row['stage']}/{row['episode']} ({e.strerror or e})") from None
         count += 1
         if bar is not None:
             bar.update(task, advance=1,
@@ -322,25 +378,15 @@ def _execute(
 
     try:
         if backend == "ray":
-            _execute_ray(todo, workers, commit, address=ray_address)
-        elif workers == 1 or len(todo) <= 1:
+            _execute_ray(todo, workers, commit, address=ray_address, timeout=episode_timeout)
+        elif workers == 0:
             for job in todo:
                 commit(run_job(job))
-        else:
-            pool = ProcessPoolExecutor(max_workers=workers, mp_context=_mp_context())
-            try:
-                pending: set[Future[Any]] = set()
-                queue = list(todo)
-                while queue or pending:
-                    while queue and len(pending) < 2 * workers:
-                        pending.add(pool.submit(run_job, queue.pop(0)))
-                    finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                    for f in finished:
-                        commit(f.result())
-            except BaseException:  # Ctrl-C or a failed commit: drop the queued jobs, stop now
-                pool.shutdown(wait=False, cancel_futures=True)
-                raise
-            pool.shutdown(wait=True)
+        elif todo:
+            from arena.eval.workers import run_jobs
+
+            run_jobs(todo, run_job, commit, _error_result, workers=workers,
+                     timeout=episode_timeout, initializer=_warm_up)
     finally:
         if bar is not None:
             bar.stop()
@@ -354,11 +400,18 @@ def _ray_run_job(config: dict[str, Any], contestant: str, local_planner: str,
 
 
 def _ray_error(e: BaseException) -> str:
-    """``"<ExceptionType>: message"`` of a failed ray task (the task's own exception if any)."""
+    """``"<ExceptionType>: message"`` of a failed ray task (the task's own exception if any).
+
+    A task whose worker process died reads ``"worker died (WorkerCrashedError: ...)"``, as
+    with the process backend.
+    """
     cause = getattr(e, "cause", None)
     err = cause if isinstance(cause, BaseException) else e
     lines = str(err).strip().splitlines()
-    return f"{type(err).__name__}: {lines[0] if lines else ''}".rstrip(": ")
+    text = f"{type(err).__name__}: {lines[0] if lines else ''}".rstrip(": ")
+    from ray.exceptions import WorkerCrashedError
+
+    return f"worker died ({text})" if isinstance(err, WorkerCrashedError) else text
 
 
 def _ray_init(ray: Any, workers: int, address: str | None) -> str | None:
@@ -393,12 +446,15 @@ def _ray_init(ray: Any, workers: int, address: str | None) -> str | None:
 
 
 def _execute_ray(todo: Sequence[Job], workers: int, commit: Callable[[Any], None],
-                 *, address: str | None = None) -> None:
+                 *, address: str | None = None, timeout: float | None = None) -> None:
     """Run the jobs as ray tasks (at most ``workers`` at once); commit in the caller.
 
     Starts a local Ray (``address=None``) or connects to ``address`` unless Ray is already
     initialized, and shuts it down afterwards only if it did. A task that fails outside
-    :func:`run_job` (its worker died, its arguments did not arrive) becomes an ``error`` row.
+    :func:`run_job` (its worker died, its arguments did not arrive) becomes an ``error`` row;
+    so does a task still running ``timeout`` seconds after it was submitted (its worker is
+    killed: ``ray.cancel(force=True)``). On a busy cluster a task may wait for a CPU, and that
+    wait counts against its limit.
     """
     import ray
 
@@ -409,7 +465,7 @@ def _execute_ray(todo: Sequence[Job], workers: int, commit: Callable[[Any], None
         configs: dict[int, Any] = {}  # one object-store copy per distinct config
         queue = list(todo)
         queue.reverse()
-        pending: dict[Any, Job] = {}
+        pending: dict[Any, tuple[Job, float]] = {}  # ref -> (job, deadline)
         try:
             while queue or pending:
                 while queue and len(pending) < workers:
@@ -419,15 +475,25 @@ def _execute_ray(todo: Sequence[Job], workers: int, commit: Callable[[Any], None
                     ref = remote.remote(configs[id(job.config)], job.contestant,
                                         job.local_planner, job.inter_planner, job.stage,
                                         job.episode)
-                    pending[ref] = job
-                ready, _ = ray.wait(list(pending), num_returns=1)
+                    limit = time.monotonic() + timeout if timeout is not None else math.inf
+                    pending[ref] = (job, limit)
+                first = min(limit for _, limit in pending.values())
+                ready, _ = ray.wait(list(pending), num_returns=1, timeout=(
+                    None if first == math.inf else max(0.0, first - time.monotonic())))
                 for ref in ready:
-                    job = pending.pop(ref)
+                    job, _ = pending.pop(ref)
                     try:
                         result = ray.get(ref)
                     except Exception as e:  # the task failed outside run_job
                         result = _error_result(job, _ray_error(e))
                     commit(result)
+                now = time.monotonic()
+                for ref, (job, limit) in list(pending.items()):
+                    if now >= limit:  # kill its worker: a hung task never yields to a cancel
+                        with contextlib.suppress(Exception):
+                            ray.cancel(ref, force=True)
+                        del pending[ref]
+                        commit(_error_result(job, f"wall-clock limit {timeout:g} s exceeded"))
         except BaseException:  # Ctrl-C or a failed commit: drop the running tasks, stop now
             for ref in pending:  # (not force=True: that kills the workers, maybe a cluster's)
                 with contextlib.suppress(Exception):

@@ -25,9 +25,18 @@ from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    StrictFloat,
+    StrictInt,
+    StrictStr,
+    ValidationError,
+)
 
 from arena import __version__
-from arena.core.errors import ArenaError
+from arena.core.errors import ArenaError, ConfigError, from_validation_error
 from arena.eval.io import save_record
 from arena.eval.record import EpisodeRecord
 
@@ -111,21 +120,38 @@ def write_manifest(
     return data
 
 
+class RunManifest(BaseModel):
+    """The fields of ``run.json`` a run needs, checked when it is read (other keys pass)."""
+
+    model_config = ConfigDict(extra="allow", allow_inf_nan=False)
+
+    suite: StrictStr = Field(min_length=1)
+    contest: StrictStr = Field(min_length=1)
+    seed: StrictInt = Field(ge=0)
+    scale: StrictFloat = Field(gt=0)
+
+
 def read_manifest(run: str | Path) -> dict[str, Any]:
-    """Read ``<run>/run.json``.
+    """Read ``<run>/run.json`` and check its :class:`RunManifest` fields.
 
     Raises:
-        ArenaError: no manifest (not a run folder) or an unreadable one.
+        ArenaError: no manifest (not a run folder), an unreadable one, or a bad field
+            (:class:`~arena.core.errors.ConfigError` naming the file and the field).
     """
     path = Path(run) / MANIFEST
     if not path.is_file():
         raise ArenaError(f"{path}: no run manifest; {run} is not a benchmark run folder")
     try:
-        data = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError) as e:
+        data = json.loads(path.read_bytes())
+    except (OSError, ValueError, RecursionError) as e:  # ValueError: bad JSON or UTF-8
         raise ArenaError(f"{path}: unreadable run manifest ({e})") from None
     if not isinstance(data, dict):
-        raise ArenaError(f"{path}: the run manifest is not a JSON object")
+        raise ConfigError(f"the run manifest is not a JSON object (got {type(data).__name__})",
+                          source=str(path))
+    try:
+        RunManifest.model_validate(data)
+    except ValidationError as e:
+        raise from_validation_error(e, source=str(path)) from None
     return data
 
 
@@ -197,22 +223,65 @@ def completed(run: str | Path) -> set[tuple[str, str, int]]:
     return out
 
 
+def _check_row(path: Path, row: Any) -> dict[str, Any]:
+    """``row`` if it is a metrics row as :func:`commit_episode` writes it, else a one-line error.
+
+    Every fixed column must have its type (``seed`` may be null) and every other value must be a
+    number or null; ``contestant``, ``stage`` and ``episode`` must match the file's place.
+    """
+    redo = "; delete the file to run that episode again (--resume)"
+    if not isinstance(row, dict):
+        raise ArenaError(f"{path}: expected an episode row (a JSON object), "
+                         f"got {type(row).__name__}{redo}")
+    for name, typ in (*ID_COLUMNS, *TAIL_COLUMNS):
+        value = row.get(name)
+        if value is None and name in ("seed", "record"):
+            continue
+        if pa.types.is_string(typ):
+            ok = isinstance(value, str)
+        elif pa.types.is_integer(typ):
+            ok = isinstance(value, int) and not isinstance(value, bool)
+        else:
+            ok = isinstance(value, int | float) and not isinstance(value, bool)
+        if not ok:
+            raise ArenaError(f"{path}: field {name!r}: expected {typ}, got {value!r}{redo}")
+    for name, value in row.items():
+        if name not in _FIXED and not (
+            value is None or (isinstance(value, int | float) and not isinstance(value, bool))
+        ):
+            raise ArenaError(f"{path}: metric {name!r}: expected a number or null, "
+                             f"got {value!r}{redo}")
+    place = (path.parent.parent.name, path.parent.name, path.stem)
+    if (row["contestant"], row["stage"], f"{row['episode']:04d}") != place:
+        raise ArenaError(f"{path}: the row is of {row['contestant']}/{row['stage']}/"
+                         f"{row['episode']}, not of the episode its file name says{redo}")
+    return row
+
+
 def load_rows(run: str | Path) -> list[dict[str, Any]]:
-    """Every committed metrics row, sorted by (contestant, stage, episode)."""
+    """Every committed metrics row, sorted by (contestant, stage, episode).
+
+    Raises:
+        ArenaError: an unreadable or malformed row file (naming it).
+    """
     rows = []
     for p in _row_files(Path(run)):
         try:
-            rows.append(json.loads(p.read_text()))
-        except (OSError, json.JSONDecodeError) as e:
-            raise ArenaError(f"{p}: unreadable episode row ({e})") from None
+            data = json.loads(p.read_bytes())
+        except (OSError, ValueError, RecursionError) as e:
+            raise ArenaError(f"{p}: unreadable episode row ({e}); delete the file to run that "
+                             f"episode again (--resume)") from None
+        rows.append(_check_row(p, data))
     rows.sort(key=lambda r: (str(r["contestant"]), str(r["stage"]), int(r["episode"])))
     return rows
 
 
+_FIXED = frozenset(n for n, _ in (*ID_COLUMNS, *TAIL_COLUMNS))
+
+
 def metric_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:
     """The metric names found in ``rows`` (every key that is no fixed column), sorted."""
-    fixed = {n for n, _ in ID_COLUMNS} | {n for n, _ in TAIL_COLUMNS}
-    return sorted({k for r in rows for k in r if k not in fixed})
+    return sorted({k for r in rows for k in r if k not in _FIXED})
 
 
 def load_results(run: str | Path) -> pa.Table:

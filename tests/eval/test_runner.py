@@ -91,10 +91,10 @@ def files(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
 
 @pytest.fixture(scope="module")
 def reference(files: tuple[Path, Path], tmp_path_factory: pytest.TempPathFactory) -> pa.Table:
-    """An uninterrupted single-process run."""
+    """An uninterrupted run in this process."""
     suite, contest = files
     run = run_benchmark(suite, contest, tmp_path_factory.mktemp("ref") / "run",
-                        base_cfg=ExperimentConfig(seed=0))
+                        base_cfg=ExperimentConfig(seed=0), workers=0)
     return load_results(run)
 
 
@@ -214,7 +214,7 @@ def test_planner_exception_is_an_error_episode(files: tuple[Path, Path], tmp_pat
         "  - {name: pp, local_planner: pure_pursuit}\n"
     )
     run = run_benchmark(suite, contest, tmp_path / "run", base_cfg=ExperimentConfig(seed=0),
-                        scale=0.5)
+                        scale=0.5, workers=0)  # in this process: the planners registered here
     rows = load_results(run).to_pylist()
     by = {c: [r for r in rows if r["contestant"] == c] for c in ("boom", "nan", "pp")}
     assert [len(v) for v in by.values()] == [2, 2, 2]

@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import math
 import operator
+import os
 import shutil
 import sys
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -175,3 +177,40 @@ def test_cli_bench_backend_ray(reference: pa.Table, contest: Path, tmp_path: Pat
     assert ok.value.code in (0, None), err
     assert "random" in out and f"run folder: {run}" in out.replace("\n", "")
     assert _rows(load_results(run)) == _rows(reference)
+
+
+class _ExitOnArrival:
+    """Pickles fine; unpickling (in the ray worker) ends that worker: ``os._exit(3)``."""
+
+    def __reduce__(self) -> tuple[Any, tuple[int]]:
+        return os._exit, (3,)
+
+
+class _HangOnArrival:
+    """Pickles fine; unpickling (in the ray worker) sleeps for an hour."""
+
+    def __reduce__(self) -> tuple[Any, tuple[int]]:
+        return time.sleep, (3600,)
+
+
+@pytest.mark.usefixtures("local_ray")
+def test_ray_dead_or_hung_worker_is_an_error_row(contest: Path) -> None:
+    from arena.tasks.suite import load_contest, load_suite
+
+    good = plan_jobs(load_suite("quick", scale_episodes=0.34), load_contest(contest)[0],
+                     ExperimentConfig(seed=0))[:1]
+    dies = Job("pp", "pure_pursuit", "bypass", "random", 7, {"robot": "jackal",
+                                                             "x": _ExitOnArrival()})
+    hangs = Job("pp", "pure_pursuit", "bypass", "random", 8, {"robot": "jackal",
+                                                              "x": _HangOnArrival()})
+    results: list[tuple[dict[str, Any], Any]] = []
+    runner._execute_ray([dies, *good], 1, results.append)
+    by = {row["episode"]: row for row, _ in results}
+    assert sorted(by) == [0, 7]
+    assert by[7]["outcome"] == "error"
+    assert by[7]["error"].startswith("worker died (WorkerCrashedError")
+    assert by[0]["outcome"] != "error"  # the run went on after the death
+    results.clear()
+    runner._execute_ray([hangs], 1, results.append, timeout=2)
+    assert [(row["episode"], row["outcome"], row["error"]) for row, _ in results] == [
+        (8, "error", "wall-clock limit 2 s exceeded")]
