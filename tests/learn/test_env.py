@@ -132,7 +132,7 @@ def test_vector_envs(kind):
     vec = gym.vector.SyncVectorEnv(fns) if kind == "sync" else gym.vector.AsyncVectorEnv(fns)
     try:
         obs, _ = vec.reset(seed=[0, 1])
-        assert obs["lidar"].shape == (2, 1, 24)
+        assert obs["lidar"].shape == (2, 24)
         for _ in range(3):
             obs, rew, *_ = vec.step(np.array([0, 6]))
         assert rew.shape == (2,) and np.all(np.isfinite(rew))
