@@ -91,8 +91,9 @@ def _materialise(tokens: list[str], root: Path) -> None:
     """Create the files a command's placeholder paths name, under ``root``.
 
     ``my_experiment.yaml`` gets :data:`EXPERIMENT`; ``path/to/X.yaml`` the packaged
-    ``small_office`` map (``map.yaml`` + image beside it; a map the demo's 12 m goals fit); ``path/to/X/…/N.json`` a scenario of
-    the packaged ``corridor`` world; ``path/to/X`` (a folder) a copy of that world.
+    ``small_office`` map (``map.yaml`` + image beside it; a map the demo's 12 m goals fit);
+    ``path/to/X/…/N.json`` a scenario of the packaged ``corridor`` world; ``path/to/X`` (a
+    folder) a copy of that world.
     """
     for tok in tokens:
         value = tok.split("=", 1)[-1]
