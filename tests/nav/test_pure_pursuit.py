@@ -421,3 +421,25 @@ def test_steps_around_a_person_who_stays_in_the_way(kin: str) -> None:
 def test_without_detour_the_robot_waits_for_good() -> None:
     pose, min_gap, _, left_path = _drive_past_standing_person(_pp(detour_after=None), "diff_drive")
     assert pose[0] < 3.0 - RADIUS - 0.3 and left_path is None and min_gap > 0.05
+
+
+@pytest.mark.parametrize("kin", ["legged", "diff_drive"])
+def test_backs_off_when_no_side_is_free(kin: str) -> None:
+    """Returns all around the front half: a robot that can reverse backs off, others wait."""
+    lim = DRIVES[kin]
+    pp = _pp()
+    angles = np.linspace(-math.pi, math.pi, 360, endpoint=False)
+    ranges = np.where(np.abs(angles) < 1.75, RADIUS + 0.1, 8.0)  # front and sides, 0.1 m away
+    path = _line(0.0, 5.0)
+    cmds = []
+    for k in range(30):
+        obs = dataclasses.replace(_obs([0, 0, 0], path, limits=lim, kinematics=kin,
+                                       ranges=ranges, angles=angles), time=k * DT)
+        cmds.append(pp.compute(obs))
+    first_reverse = next((k for k, c in enumerate(cmds) if c[0] < 0), None)
+    if lim.vx_min < 0:
+        assert first_reverse is not None
+        assert first_reverse * DT >= pp.params.detour_after - 1e-9  # it waited first
+        assert all(c[0] <= 0 and c[2] == 0 for c in cmds[first_reverse:])  # straight back
+    else:
+        assert first_reverse is None and all(c[0] == 0 for c in cmds)

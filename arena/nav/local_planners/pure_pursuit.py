@@ -47,8 +47,11 @@ Detour:
     among the straight headings 15°, 30°, … 90° to either side (inside the laser's field of
     view) it takes the one closest to its lookahead point whose corridor is free for
     ``detour_distance`` (ties: away from the nearest return), turns to it, drives that far
-    (with the usual obstacle check), then follows the path again. The global path is not
-    changed; the stack replans if the detour took the robot more than its
+    (with the usual obstacle check), then follows the path again. When no side is free (a
+    person pressed against the robot beside a wall) a robot that can reverse backs off
+    ``detour_distance / 2`` at 0.2 m/s if the corridor behind shows no return (a laser that
+    does not look back leaves it unseen: the robot came from there), then tries again. The
+    global path is not changed; the stack replans if the detour took the robot more than its
     ``max_path_deviation`` away.
 
 Limitations:
@@ -95,6 +98,8 @@ _DETOUR_REACHED = 0.1
 _BLOCKED_SPEED_FRACTION = 0.1
 # rad: a detour turns on the spot until its heading error is below this, then drives.
 _DETOUR_ALIGN = 0.1
+# m/s of a back-off (reversing when no side is free), capped by the robot's reverse limit.
+_BACKOFF_SPEED = 0.2
 
 
 @LOCAL_PLANNERS.register("pure_pursuit", tags=("default", "classic"))
@@ -194,6 +199,8 @@ class PurePursuitPlanner:
         self._blocked_since: float | None = None
         self._detour: NDArray[np.float64] | None = None  # (2,) world target of the detour
         self._detour_until = 0.0
+        self._backoff: NDArray[np.float64] | None = None  # (2,) world point reversed to
+        self._backoff_until = 0.0
 
     # -- path tracking ----------------------------------------------------------------------------
     def _track(self, path: NDArray[np.float64], xy: NDArray[np.float64]) -> tuple[float, float]:
@@ -338,6 +345,10 @@ class PurePursuitPlanner:
                     cmd[2] = p.heading_gain * err
             return limit_command(cmd, twist, lim, dt)
 
+        backing = self._backoff_command(obs)
+        if backing is not None:
+            return backing
+
         d_goal = max(total - s, d_end)
         decel = p.decel_fraction * lim.acc_x
         v_ref = min(lim.vx_max, p.max_speed) if p.max_speed is not None else lim.vx_max
@@ -462,7 +473,8 @@ class PurePursuitPlanner:
             return None
         delta = self._detour_heading(obs, points, math.atan2(ty, tx))
         if delta is None:
-            return None  # no free side: keep waiting
+            self._start_backoff(obs, points, pose)
+            return None  # no free side: back off if possible, else keep waiting
         self._blocked_since = None
         local = p.detour_distance * np.array([math.cos(delta), math.sin(delta)])
         self._detour = pose[:2] + np.array([c * local[0] - sn * local[1],
@@ -473,6 +485,38 @@ class PurePursuitPlanner:
             p.detour_distance / max(min(v_ref, lim.vx_max), 0.05)
         )
         return float(local[0]), float(local[1])
+
+    def _start_backoff(
+        self, obs: LocalObservation, points: NDArray[np.float64], pose: NDArray[np.float64]
+    ) -> None:
+        """Reverse half a detour distance when no side is free and the corridor behind is."""
+        p = self.params
+        if obs.limits.vx_min >= 0.0:
+            return  # cannot reverse
+        back = 0.5 * p.detour_distance
+        # beams that do not look back leave the rear unseen: the robot came from there
+        gap = self._free_gaps(points, np.array([-1.0, 0.0]), 0.0, obs.robot_radius)[0]
+        if gap < back + p.stop_distance:
+            return
+        c, sn = math.cos(pose[2]), math.sin(pose[2])
+        self._blocked_since = None
+        self._backoff = pose[:2] - back * np.array([c, sn])
+        speed = min(_BACKOFF_SPEED, -obs.limits.vx_min)
+        self._backoff_until = float(obs.time) + 3.0 * back / speed
+
+    def _backoff_command(self, obs: LocalObservation) -> NDArray[np.float64] | None:
+        """The reversing command while a back-off runs, else ``None`` (it ended)."""
+        if self._backoff is None:
+            return None
+        pose = np.asarray(obs.pose, dtype=np.float64).reshape(3)
+        if (float(np.hypot(*(self._backoff - pose[:2]))) <= _DETOUR_REACHED
+                or float(obs.time) >= self._backoff_until):
+            self._backoff = None
+            return None
+        lim = obs.limits
+        twist = np.asarray(obs.twist, dtype=np.float64).reshape(3)
+        speed = min(_BACKOFF_SPEED, -lim.vx_min)
+        return limit_command(np.array([-speed, 0.0, 0.0]), twist, lim, float(obs.dt))
 
     def _detour_heading(
         self, obs: LocalObservation, points: NDArray[np.float64], preferred: float
