@@ -23,8 +23,9 @@ Default suite (:func:`test_readme_commands_parse_and_validate`):
 
 Slow suite (:func:`test_readme_runs_every_command_and_snippet`, ``pytest -m slow``): every
 command and snippet runs in full, with these reductions appended to keep it minutes long:
-``arena run`` gets ``-n 1`` (one episode); ``arena bench`` gets ``--scale 0.25``; ``arena
-train`` gets ``--steps 256 --envs 1``; ``--interactive`` runs get ``reset`` on stdin (the episode
+``arena run`` gets ``-n 1`` (one episode); ``arena bench paper`` gets ``--scale 0.1`` (13 of
+160 episodes, every stage kept; ``quick`` runs in full); ``arena train`` gets ``--steps 256
+--envs 1``; ``--interactive`` runs get ``reset`` on stdin (the episode
 ends at once instead of running for a minute of wall time).
 """
 
@@ -55,10 +56,21 @@ PARSE_ONLY = ("bench", "train", "report")
 
 REDUCTIONS: dict[str, list[str]] = {
     "run": ["-n", "1"],
-    "bench": ["--scale", "0.25"],
     "train": ["--steps", "256", "--envs", "1"],
 }
 """Arguments the slow test appends to keep each command short (the last option wins)."""
+
+BENCH_SCALES = {"paper": "0.1"}
+"""``--scale`` the slow test gives ``arena bench SUITE``: the paper suite's 160 episodes become
+13, every stage kept; ``quick`` (8 episodes) runs in full."""
+
+
+def _reduced(args: list[str]) -> list[str]:
+    """``args`` with the slow test's reductions appended."""
+    extra = list(REDUCTIONS.get(args[0], []))
+    if args[0] == "bench" and len(args) > 1 and args[1] in BENCH_SCALES:
+        extra += ["--scale", BENCH_SCALES[args[1]]]
+    return [*args, *extra]
 
 EXPERIMENT = "name: my_experiment\nrobot: burger\nepisodes: 1\noutput: {video: false}\n"
 """The ``my_experiment.yaml`` the README's examples refer to."""
@@ -193,7 +205,7 @@ def test_readme_runs_every_command_and_snippet(tmp_path, monkeypatch):
     failures = []
     for args in COMMANDS:
         _materialise(args, tmp_path)
-        full = [*args, *REDUCTIONS.get(args[0], [])]
+        full = _reduced(args)
         stdin = "reset\nquit\n" if "--interactive" in args else ""
         code, output = _invoke(full, stdin)
         if code != 0:
