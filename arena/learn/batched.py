@@ -53,11 +53,11 @@ from arena.learn.actions import ActionDecoder
 from arena.learn.driver import (
     ConfigLike,
     SubgoalTracker,
-    check_config_keywords,
     planning_grid,
     resolve_config,
     substeps,
 )
+from arena.learn.keywords import check_config_keywords
 from arena.learn.observations import Obs, ObservationBuilder, ObsInput
 from arena.learn.prefetch import EpisodePrefetcher
 from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput

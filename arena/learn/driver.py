@@ -12,8 +12,6 @@ a benchmark episode with the same seed and index share map, starts, goals and cr
 
 from __future__ import annotations
 
-import difflib
-import json
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -25,7 +23,6 @@ from numpy.typing import NDArray
 from scipy import ndimage
 
 import arena.plugins  # noqa: F401  (fills the registries)
-from arena.config.loader import load_config
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, PlanningError, SamplingError, StartOccupied
 from arena.core.rng import derive_rng
@@ -33,6 +30,7 @@ from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
 from arena.learn.actions import ActionDecoder
 from arena.learn.config import EnvConfig, SubgoalObsConfig
+from arena.learn.keywords import load_with_keywords
 from arena.learn.observations import Obs, ObservationBuilder, ObsInput
 from arena.learn.paths import project_on_path, subgoal_on_path
 from arena.learn.rewards import (
@@ -70,16 +68,13 @@ def resolve_config(
     Args:
         config: a built config, a YAML path or ``None`` (the packaged default).
         overrides: ``key.path=value`` strings, applied to the YAML.
-        keywords: top-level config keys given as keyword arguments (``robot="burger"``,
-            ``map={"type": "empty", "width": 8}``), applied after ``overrides`` exactly as the
-            override ``key=value`` would be (a block with a new ``type`` replaces the old one).
+        keywords: top-level config keys given as keyword arguments, applied after
+            ``overrides`` (see :func:`~arena.learn.keywords.load_with_keywords`).
         owner: the class named in error messages.
 
     Raises:
-        ConfigError: an unknown keyword (with the config keys and a close match), a value
-            that is not plain data, or an invalid config; one line naming the keyword.
+        ConfigError: an invalid config, override or keyword, in one line.
     """
-    keywords = dict(keywords or {})
     if isinstance(config, ExperimentConfig):
         if overrides or keywords:
             raise ConfigError(
@@ -87,54 +82,7 @@ def resolve_config(
                 "not to a built ExperimentConfig (use cfg.model_copy(update=...))"
             )
         return config
-    texts: dict[str, str] = {}
-    for key, value in keywords.items():
-        texts[f"{key}={_yaml_value(owner, key, value)}"] = key
-    try:
-        return load_config(config, [*overrides, *texts])
-    except ConfigError as e:
-        src = (e.source or "").removeprefix("override ")
-        for text, key in texts.items():
-            if src == repr(text):
-                raise ConfigError(
-                    e.message, source=f"{owner}({key}={keywords[key]!r})", path=e.path
-                ) from None
-        raise
-
-
-def check_config_keywords(owner: str, keywords: Mapping[str, Any]) -> None:
-    """Raise a one-line :class:`ConfigError` for a keyword that is not a config key."""
-    known = sorted(ExperimentConfig.model_fields)
-    for key in keywords:
-        if key not in known:
-            close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
-            hint = f"; did you mean {close[0]!r}?" if close else ""
-            raise ConfigError(
-                f"{owner}: unknown keyword argument {key!r}{hint} (expected 'config', "
-                f"'overrides', the env's own arguments or a config key: {', '.join(known)})"
-            )
-
-
-def _yaml_value(owner: str, key: str, value: Any) -> str:
-    """``value`` as a YAML flow text for an override (paths as strings, numpy as Python)."""
-
-    def plain(v: Any) -> Any:
-        if isinstance(v, Mapping):
-            return {str(k): plain(x) for k, x in v.items()}
-        if isinstance(v, list | tuple):
-            return [plain(x) for x in v]
-        if isinstance(v, Path):
-            return str(v)
-        if isinstance(v, np.generic | np.ndarray):
-            return plain(v.tolist())
-        if v is None or isinstance(v, bool | int | float | str):
-            return v
-        raise ConfigError(
-            f"{owner}({key}=...): a value of type {type(v).__name__} is not config data "
-            "(expected strings, numbers, booleans, lists and dicts)"
-        )
-
-    return json.dumps(plain(value))  # JSON is YAML flow syntax
+    return load_with_keywords(config, overrides, keywords or {}, owner)
 
 
 def substeps(env: EnvConfig, dt: float) -> int:

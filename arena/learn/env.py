@@ -83,9 +83,9 @@ from arena.learn.driver import (
     ConfigLike,
     EpisodeDriver,
     action_period_fps,
-    check_config_keywords,
     resolve_config,
 )
+from arena.learn.keywords import check_config_keywords
 from arena.robots.model import RobotModel
 
 
