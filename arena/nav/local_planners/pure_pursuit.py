@@ -52,7 +52,9 @@ Detour:
     ``detour_distance / 2`` at 0.2 m/s if the corridor behind shows no return (a laser that
     does not look back leaves it unseen: the robot came from there), then tries again. The
     global path is not changed; the stack replans if the detour took the robot more than its
-    ``max_path_deviation`` away.
+    ``max_path_deviation`` away. Measured on the demo with the go1 (2026-11-27; without the
+    detour → with it): the README's 5 episodes 1 → 4 goals; 20 episodes of seed 0 11 → 19 goals
+    (46 → 19 contacts); 5 episodes each of seeds 1–4 16 → 18 goals (21 → 22 contacts).
 
 Limitations:
     It never reverses, so a car-like robot that ends up facing a wall stays there; returns are
