@@ -47,6 +47,11 @@ from typing import Any
 import numpy as np
 
 
+def _newest_scan(lidar: np.ndarray) -> np.ndarray:
+    """``(B, beams)``: the newest scan of a batched ``lidar`` (``(B, beams)`` or stacked)."""
+    return lidar[:, -1, :] if lidar.ndim == 3 else lidar
+
+
 def _normalised(raw: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
     return (2.0 * (raw - low) / (high - low) - 1.0).astype(np.float32)
 
@@ -63,7 +68,7 @@ def expert(
     in 19.1 s on average, 1.6/1.6 54 in 11.2 s, 2.0/2.5 53 in 8.6 s with more collisions.
     """
     th = obs["goal"][:, 1]
-    lid = obs["lidar"][:, -1, :]
+    lid = _newest_scan(obs["lidar"])
     beams = lid.shape[1]
     c = beams // 2  # the jackal's beams are symmetric about straight ahead
     w = max(1, beams // 24)
@@ -94,7 +99,7 @@ def gap_expert(
     rho, th = obs["goal"][:, 0].astype(np.float64), obs["goal"][:, 1].astype(np.float64)
     step = max(1, angles.size // 180)  # a quarter degree per beam is more than needed
     a = angles[::step]
-    r = obs["lidar"][:, -1, ::step].astype(np.float64)  # (B, P)
+    r = _newest_scan(obs["lidar"])[:, ::step].astype(np.float64)  # (B, P)
     cand = np.linspace(a[0] + 0.2, a[-1] - 0.2, 41)  # (K,) rad
     d = a[None, :] - cand[:, None]  # (K, P)
     along = r[:, None, :] * np.cos(d)[None]

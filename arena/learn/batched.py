@@ -57,6 +57,7 @@ from arena.learn.driver import (
     resolve_config,
     substeps,
 )
+from arena.learn.keywords import check_config_keywords
 from arena.learn.observations import Obs, ObservationBuilder, ObsInput
 from arena.learn.prefetch import EpisodePrefetcher
 from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput
@@ -87,7 +88,8 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         config: an :class:`ExperimentConfig`, a YAML path or ``None`` (the packaged default).
         overrides: ``key.path=value`` overrides (with a path or ``None`` only).
         num_envs: ``N``, the number of worlds.
-        robot: a robot model replacing ``cfg.robot``.
+        robot: a preset name or robot YAML path (the config key), or a robot model
+            replacing ``cfg.robot``.
         sim_params: parameters of the batched simulator.
         autoreset_mode: ``NEXT_STEP`` (default) or ``SAME_STEP``.
         prefetch: episodes per world drawn ahead by a helper process
@@ -95,6 +97,8 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             process when a world restarts. The episodes, and so every result, are the same
             either way; prefetching overlaps the drawing with the simulation (one more process;
             :meth:`close` stops it).
+        **config_keys: other top-level config keys (``map``, ``task``, ``seed``, …), applied
+            as in :class:`~arena.learn.env.SocialNavEnv`.
     """
 
     metadata = {  # noqa: RUF012  (gymnasium declares it an instance attribute)
@@ -108,10 +112,11 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         overrides: Sequence[str] = (),
         *,
         num_envs: int = 1,
-        robot: RobotModel | None = None,
+        robot: RobotModel | str | os.PathLike[str] | None = None,
         sim_params: BatchSim.Params | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         prefetch: int = 0,
+        **config_keys: Any,
     ) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be >= 1, got {num_envs}")
@@ -120,7 +125,12 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             raise ValueError("autoreset_mode must be NEXT_STEP or SAME_STEP")
         self.autoreset_mode = mode
         self.metadata = {**self.metadata, "autoreset_mode": mode}
-        self.cfg = resolve_config(config, overrides)
+        owner = type(self).__name__
+        check_config_keywords(owner, config_keys)
+        if robot is not None and not isinstance(robot, RobotModel):
+            config_keys["robot"] = robot  # a preset name or a robot file: the config key
+            robot = None
+        self.cfg = resolve_config(config, overrides, config_keys, owner=owner)
         self.env_cfg = self.cfg.learning.env
         self.robot = robot if robot is not None else load_robot(self.cfg.robot)
         self.num_envs = n = int(num_envs)

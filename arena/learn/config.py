@@ -89,7 +89,9 @@ class SubgoalObsConfig(_Strict):
 class ObservationConfig(_Strict):
     """Which observation parts the environment returns."""
 
-    lidar: bool = Field(True, description="'lidar': (laser_stack, beams) ranges in m")
+    lidar: bool = Field(
+        True, description="'lidar': (beams,) ranges in m; (laser_stack, beams) if stacked"
+    )
     goal: bool = Field(True, description="'goal': [ρ m, θ rad] in the robot frame")
     last_action: bool = Field(True, description="'last_action': [vx, vy, ω] last command")
     velocity: bool = Field(

@@ -13,7 +13,7 @@ a benchmark episode with the same seed and index share map, starts, goals and cr
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -23,7 +23,6 @@ from numpy.typing import NDArray
 from scipy import ndimage
 
 import arena.plugins  # noqa: F401  (fills the registries)
-from arena.config.loader import load_config
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, PlanningError, SamplingError, StartOccupied
 from arena.core.rng import derive_rng
@@ -31,6 +30,7 @@ from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
 from arena.learn.actions import ActionDecoder
 from arena.learn.config import EnvConfig, SubgoalObsConfig
+from arena.learn.keywords import load_with_keywords
 from arena.learn.observations import Obs, ObservationBuilder, ObsInput
 from arena.learn.paths import project_on_path, subgoal_on_path
 from arena.learn.rewards import (
@@ -56,13 +56,33 @@ FloatArray = NDArray[np.float64]
 ConfigLike = ExperimentConfig | str | Path | None
 
 
-def resolve_config(config: ConfigLike, overrides: Sequence[str] = ()) -> ExperimentConfig:
-    """An :class:`ExperimentConfig` from a config, a YAML path (+ overrides) or ``None``."""
+def resolve_config(
+    config: ConfigLike,
+    overrides: Sequence[str] = (),
+    keywords: Mapping[str, Any] | None = None,
+    *,
+    owner: str = "SocialNavEnv",
+) -> ExperimentConfig:
+    """An :class:`ExperimentConfig` from a config, a YAML path (+ overrides) or ``None``.
+
+    Args:
+        config: a built config, a YAML path or ``None`` (the packaged default).
+        overrides: ``key.path=value`` strings, applied to the YAML.
+        keywords: top-level config keys given as keyword arguments, applied after
+            ``overrides`` (see :func:`~arena.learn.keywords.load_with_keywords`).
+        owner: the class named in error messages.
+
+    Raises:
+        ConfigError: an invalid config, override or keyword, in one line.
+    """
     if isinstance(config, ExperimentConfig):
-        if overrides:
-            raise ValueError("overrides apply to a YAML path, not to a built config")
+        if overrides or keywords:
+            raise ConfigError(
+                f"{owner}: overrides and config keywords apply to a YAML path or None, "
+                "not to a built ExperimentConfig (use cfg.model_copy(update=...))"
+            )
         return config
-    return load_config(config, overrides)
+    return load_with_keywords(config, overrides, keywords or {}, owner)
 
 
 def substeps(env: EnvConfig, dt: float) -> int:

@@ -55,24 +55,37 @@ Episode End:
 Arguments:
     config: an :class:`~arena.config.schema.ExperimentConfig`, a YAML path or ``None`` (the
         packaged default); ``overrides`` (``key.path=value``) apply to a path.
-    robot: a robot model replacing ``cfg.robot`` (e.g. fewer beams).
+    robot: a preset name or robot YAML path (the config key ``robot``), or a
+        :class:`~arena.robots.model.RobotModel` replacing ``cfg.robot`` (e.g. fewer beams).
     render_mode: ``None`` or ``"rgb_array"``.
+    **config_keys: any other top-level config key (``map``, ``task``, ``crowd``, ``seed``,
+        ``learning``, …), applied after ``overrides`` as the override ``key=value`` would be;
+        an unknown keyword is a one-line :class:`~arena.core.errors.ConfigError`.
 
 Example::
 
     import gymnasium as gym
     import arena.learn  # registers the id
     env = gym.make("arena/SocialNav-v0", config="my.yaml", overrides=["learning.env.max_steps=300"])
+    env = gym.make("arena/SocialNav-v0", robot="burger", map={"type": "empty", "width": 10},
+                   overrides=["task.obstacles.dynamic=5"])
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any, ClassVar, SupportsFloat
 
 import gymnasium as gym
 
-from arena.learn.driver import ConfigLike, EpisodeDriver, action_period_fps, resolve_config
+from arena.learn.driver import (
+    ConfigLike,
+    EpisodeDriver,
+    action_period_fps,
+    resolve_config,
+)
+from arena.learn.keywords import check_config_keywords
 from arena.robots.model import RobotModel
 
 
@@ -86,12 +99,17 @@ class SocialNavEnv(gym.Env[Any, Any]):
         config: ConfigLike = None,
         overrides: Sequence[str] = (),
         *,
-        robot: RobotModel | None = None,
+        robot: RobotModel | str | Path | None = None,
         render_mode: str | None = None,
+        **config_keys: Any,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be one of {self.metadata['render_modes']}")
-        self.cfg = resolve_config(config, overrides)
+        check_config_keywords(type(self).__name__, config_keys)
+        if robot is not None and not isinstance(robot, RobotModel):
+            config_keys["robot"] = robot  # a preset name or a robot file: the config key
+            robot = None
+        self.cfg = resolve_config(config, overrides, config_keys, owner=type(self).__name__)
         self.driver = EpisodeDriver(self.cfg, robot, n_robots=1)
         self.render_mode = render_mode
         self.metadata = {**self.metadata, "render_fps": action_period_fps(self.driver.period)}

@@ -30,7 +30,8 @@ class RLCAConvExtractor(BaseFeaturesExtractor):
     space flattened in the space's key order (:attr:`other_keys`).
 
     Args:
-        observation_space: a Dict space holding ``scan_key`` with shape ``(stack, beams)``.
+        observation_space: a Dict space holding ``scan_key`` with shape ``(stack, beams)``
+            (or ``(beams,)``: one channel).
         scan_key, filters, kernels, strides, fc: see
             :class:`~arena.learn.train_config.RLCAConvExtractorConfig`.
     """
@@ -51,13 +52,14 @@ class RLCAConvExtractor(BaseFeaturesExtractor):
                 "(observation.flatten: false, observation.lidar: true)",
                 path="learning.ppo.extractor",
             )
-        scan_space = observation_space[scan_key]
-        if len(scan_space.shape or ()) != 2:
+        scan_shape = tuple(int(v) for v in observation_space[scan_key].shape or ())
+        if len(scan_shape) not in (1, 2):
             raise ConfigError(
-                f"observation {scan_key!r} has shape {scan_space.shape}; expected (stack, beams)",
+                f"observation {scan_key!r} has shape {scan_shape}; expected (beams,) or "
+                "(stack, beams)",
                 path="learning.ppo.extractor",
             )
-        stack, beams = (int(v) for v in scan_space.shape)  # type: ignore[union-attr]
+        stack, beams = scan_shape if len(scan_shape) == 2 else (1, scan_shape[0])
         layers: list[nn.Module] = []
         channels, length = stack, beams
         for f, k, s in zip(filters, kernels, strides, strict=True):
@@ -77,7 +79,10 @@ class RLCAConvExtractor(BaseFeaturesExtractor):
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
         """``(B, features_dim)`` features of a batch of (normalised) observations."""
-        scan = self.fc(self.convs(observations[self.scan_key]))
+        x = observations[self.scan_key]
+        if x.dim() == 2:  # one scan (B, beams): one channel
+            x = x.unsqueeze(1)
+        scan = self.fc(self.convs(x))
         rest = [observations[k].flatten(1) for k in self.other_keys]
         return torch.cat([scan, *rest], dim=1)
 

@@ -4,7 +4,8 @@ Dict keys (each present only when enabled; arrays below are per world, the build
 them with a leading ``N`` axis):
 
 ================== =================== =======================================================
-``lidar``          ``(stack, beams)``  ranges (m) in ``[0, range_max]``, oldest scan first
+``lidar``          ``(beams,)``        ranges (m) in ``[0, range_max]``; ``(stack, beams)``,
+                                       oldest scan first, when ``laser_stack > 1``
 ``goal``           ``(2,)``            ``[ρ m, θ rad]``, robot frame, θ = 0 straight ahead,
                                        ρ clipped to ``goal_max_distance``
                                        (Arena offsets θ by π, §10.9; we do not)
@@ -56,6 +57,15 @@ PED_FEATURES = ("x", "y", "vx", "vy", "type", "social_state")
 MAX_SPEED = 20.0
 """m/s; velocity features are clipped to ±this (keeps the space bounded)."""
 _N_STATES = 7
+
+
+def lidar_shape(stack: int, beams: int) -> tuple[int, ...]:
+    """Shape of one robot's ``lidar`` observation: ``(beams,)``, or ``(stack, beams)`` if stacked.
+
+    One scan is a plain vector, as Gymnasium's frame-stacking convention has it (the stack axis
+    appears only when scans are stacked); batched observations add a leading world axis.
+    """
+    return (int(beams),) if int(stack) == 1 else (int(stack), int(beams))
 
 
 @dataclass(frozen=True, eq=False)
@@ -162,7 +172,7 @@ class ObservationBuilder:
         parts: dict[str, spaces.Box] = {}
         if config.lidar:
             parts["lidar"] = spaces.Box(
-                0.0, self.range_max, (config.laser_stack, self.beams), np.float32
+                0.0, self.range_max, lidar_shape(config.laser_stack, self.beams), np.float32
             )
         if config.goal:
             parts["goal"] = spaces.Box(
@@ -240,7 +250,8 @@ class ObservationBuilder:
         cfg = self.config
         # The array method clip is np.clip without its dispatch layer (this runs every step).
         if self._lidar:
-            out["lidar"] = inp.scans.clip(0.0, self.range_max).astype(np.float32)
+            scans = inp.scans if cfg.laser_stack > 1 else inp.scans[:, 0]
+            out["lidar"] = scans.clip(0.0, self.range_max).astype(np.float32)
         if self._goal:
             if n == 1:
                 rho_1, theta_1 = self._goal_single(inp.poses, inp.goals)

@@ -380,6 +380,7 @@ class NumpyPolicy:
         self.arrays = {k: np.asarray(v) for k, v in arrays.items() if k != "meta"}
         self.keys: tuple[str, ...] = tuple(self.meta["obs"]["keys"])
         self.shapes = {k: tuple(s) for k, s in self.meta["obs"]["shapes"].items()}
+        self._unstack_single_scan()
         self.is_dict = self.meta["obs"]["type"] == "dict"
         n = int(self.meta["n_layers"])
         self._w = [self.arrays[f"w{i}"].astype(np.float64) for i in range(n)]
@@ -405,6 +406,22 @@ class NumpyPolicy:
             ]
             self._fc = (self.arrays["fx/fc/w"].astype(np.float64),
                         self.arrays["fx/fc/b"].astype(np.float64))
+
+    def _unstack_single_scan(self) -> None:
+        """Read a ``lidar`` of shape ``(1, beams)`` (older files) as ``(beams,)``.
+
+        The environments give one scan as ``(beams,)`` (see
+        :func:`~arena.learn.observations.lidar_shape`); the normalisation statistics and space
+        bounds of such a file are reshaped once here, so older files keep working unchanged.
+        """
+        shape = self.shapes.get("lidar")
+        if shape is None or len(shape) != 2 or shape[0] != 1:
+            return
+        self.shapes["lidar"] = (shape[1],)
+        for part in ("low", "high", "mean", "var"):
+            key = f"{part}/lidar"
+            if key in self.arrays and self.arrays[key].shape == shape:
+                self.arrays[key] = self.arrays[key].reshape(shape[1])
 
     @classmethod
     def load(cls, path: str | Path) -> NumpyPolicy:
@@ -468,6 +485,8 @@ class NumpyPolicy:
                 [parts[k].reshape(parts[k].shape[0], -1) for k in self.keys], axis=1
             )
         x = parts[self.extractor["scan_key"]]  # (B, stack, beams): channels × length
+        if x.ndim == 2:  # one scan (B, beams): one channel
+            x = x[:, None, :]
         for w, b, stride in self._conv:
             x = np.maximum(conv1d(x, w, b, stride), 0.0)
         w_fc, b_fc = self._fc

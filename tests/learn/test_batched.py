@@ -182,12 +182,12 @@ def test_sb3_vec_env() -> None:
     venv = SB3VecEnv(small_cfg("learning.env.max_steps=5"), robot=small_robot(), num_envs=3)
     venv.seed(1)
     obs = venv.reset()
-    assert obs["lidar"].shape == (3, 1, 24)
+    assert obs["lidar"].shape == (3, 24)
     for _ in range(5):
         obs, rew, done, infos = venv.step(np.zeros(3, dtype=np.int64))
     assert done.all() and rew.shape == (3,)
     assert all(i["TimeLimit.truncated"] for i in infos)
-    assert infos[0]["terminal_observation"]["lidar"].shape == (1, 24)
+    assert infos[0]["terminal_observation"]["lidar"].shape == (24,)
     assert [i["episode_index"] for i in infos] == [0, 1, 2]  # the finished episodes
     assert venv.get_attr("num_envs") == [3, 3, 3]
 

@@ -7,7 +7,9 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
+import arena.core.errors
 import arena.learn
+import arena.learn.env
 from arena.learn.env import SocialNavEnv
 from tests.learn.helpers import small_cfg, small_robot
 
@@ -132,7 +134,7 @@ def test_vector_envs(kind):
     vec = gym.vector.SyncVectorEnv(fns) if kind == "sync" else gym.vector.AsyncVectorEnv(fns)
     try:
         obs, _ = vec.reset(seed=[0, 1])
-        assert obs["lidar"].shape == (2, 1, 24)
+        assert obs["lidar"].shape == (2, 24)
         for _ in range(3):
             obs, rew, *_ = vec.step(np.array([0, 6]))
         assert rew.shape == (2,) and np.all(np.isfinite(rew))
@@ -178,3 +180,52 @@ def test_one_robot_scalar_reward_input_matches_the_batched_input(reward):
         if term or trunc:
             env.reset()
     assert len(seen) == 60
+
+
+def test_gym_make_takes_config_keys_as_keywords():
+    """Keywords are config keys: a preset name, blocks merged as overrides, dotted overrides."""
+    env = gym.make(
+        "arena/SocialNav-v0", robot="burger", map={"type": "empty", "width": 10},
+        task={"robots": {"min_goal_distance": 3.0}}, overrides=["task.obstacles.dynamic=2"],
+    )
+    cfg = env.unwrapped.cfg
+    assert cfg.robot == "burger" and cfg.map == {"type": "empty", "width": 10}
+    assert cfg.task.obstacles["dynamic"] == 2 and cfg.task.obstacles["static"] == 4  # merged
+    obs, _ = env.reset(seed=0)
+    # one robot, one scan: (beams,), the burger's 360 beams
+    assert obs["lidar"].shape == env.observation_space["lidar"].shape == (360,)
+    env.close()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"robots": "burger"}, "SocialNavEnv: unknown keyword argument 'robots'; did you mean "
+                               "'robot'?"),
+        ({"robot": "burgr"}, "SocialNavEnv(robot='burgr'): robot: unknown robot 'burgr'"),
+        ({"map": {"type": "empty", "width": "x"}}, "SocialNavEnv(map={'type': 'empty', "
+                                                   "'width': 'x'}): map.width: "),
+        ({"seed": object()}, "SocialNavEnv(seed=...): a value of type object is not config data"),
+    ],
+)
+def test_bad_keywords_are_one_line_config_errors(kwargs, message):
+    with pytest.raises(arena.core.errors.ConfigError) as e:
+        gym.make("arena/SocialNav-v0", **kwargs)
+    assert str(e.value).startswith(message) and "\n" not in str(e.value)
+
+
+def test_environments_import_from_the_package():
+    from arena.learn import BatchedSocialNavEnv, MultiRobotEnv, SocialNavEnv
+    from arena.learn.batched import BatchedSocialNavEnv as batched
+    from arena.learn.multi import MultiRobotEnv as multi
+
+    assert BatchedSocialNavEnv is batched and MultiRobotEnv is multi
+    assert SocialNavEnv is arena.learn.env.SocialNavEnv
+    with pytest.raises(AttributeError, match="has no attribute 'Nope'"):
+        arena.learn.Nope  # noqa: B018
+
+
+def test_stacked_scans_keep_their_stack_axis():
+    env = SocialNavEnv(small_cfg("learning.env.observation.laser_stack=3"), robot=small_robot())
+    obs, _ = env.reset(seed=0)
+    assert obs["lidar"].shape == (3, 24)

@@ -222,3 +222,30 @@ def test_format_1_files_still_load(tmp_path):
     model, venv = _model(DICT_OBS, BOX)
     pol = NumpyPolicy.load(export_policy(model, venv, tmp_path / "p.npz"))
     assert pol.meta["format"] == 1 and pol.extractor is None
+
+
+def test_files_with_a_1_by_beams_lidar_read_one_scan(tmp_path):
+    """Files written when one scan was shaped (1, beams) act on today's (beams,) scans."""
+    import json
+
+    from arena.learn.env import SocialNavEnv
+    from arena.learn.policy import write_random_policy
+    from tests.learn.helpers import small_cfg, small_robot
+
+    cfg, robot = small_cfg(), small_robot(12)
+    obs, _ = SocialNavEnv(cfg, robot=robot).reset(seed=0)
+    assert obs["lidar"].shape == (12,)
+    path = write_random_policy(tmp_path / "new.npz", cfg.learning.env, robot, rng=3)
+    with np.load(path) as data:
+        arrays = {k: data[k] for k in data.files}
+    meta = json.loads(str(arrays["meta"]))
+    assert meta["obs"]["shapes"]["lidar"] == [12]
+    meta["obs"]["shapes"]["lidar"] = [1, 12]  # the older layout
+    for k in ("low/lidar", "high/lidar", "mean/lidar", "var/lidar"):
+        if k in arrays:
+            arrays[k] = arrays[k].reshape(1, 12)
+    arrays["meta"] = np.array(json.dumps(meta))
+    np.savez(tmp_path / "old.npz", **arrays)
+    old, new = NumpyPolicy.load(tmp_path / "old.npz"), NumpyPolicy.load(path)
+    assert old.shapes["lidar"] == (12,)
+    np.testing.assert_array_equal(old.logits(obs), new.logits(obs))

@@ -138,7 +138,7 @@ def test_planner_on_any_laser(tmp_path, beams):
                             limits=o.limits, robot_radius=o.robot_radius, dt=o.dt,
                             scan_ranges=rng.uniform(0.2, 12.0, beams), scan_angles=angles)
     lidar = planner.observation(scan)["lidar"]
-    assert lidar.shape == (1, BEAMS)
+    assert lidar.shape == (BEAMS,)  # one scan: (beams,), as SocialNavEnv gives it
     assert np.all((lidar >= 0) & (lidar <= robot.laser.range_max))
     if beams == 0:
         assert np.all(lidar == robot.laser.range_max)

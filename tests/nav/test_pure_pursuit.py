@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -381,3 +382,64 @@ def test_observation_is_not_mutated() -> None:
     _pp().compute(obs)
     for k, v in copies.items():
         np.testing.assert_array_equal(getattr(obs, k), v)
+
+
+def _drive_past_standing_person(pp: PurePursuitPlanner, kin: str, ticks: int = 400):
+    """Drive a straight 8 m path with a person standing on it at x = 3 m; time advances."""
+    lim = DRIVES[kin]
+    path = _line(0.0, 8.0)
+    ped, ped_r = np.array([3.0, 0.0]), 0.3
+    pose, twist = np.zeros(3), np.zeros(3)
+    stopped, left_path, min_gap = None, None, math.inf
+    for k in range(ticks):
+        ranges, angles = _scan_of_disc(pose, ped, ped_r)
+        obs = _obs(pose, path, twist=twist, limits=lim, kinematics=kin, ranges=ranges,
+                   angles=angles)
+        obs = dataclasses.replace(obs, time=k * DT)
+        cmd = pp.compute(obs)
+        _within_limits(cmd, twist, lim, ackermann=False)
+        pose, twist = _integrate(pose, cmd), cmd
+        min_gap = min(min_gap, float(np.linalg.norm(pose[:2] - ped)) - RADIUS - ped_r)
+        if stopped is None and k > 5 and abs(cmd[0]) < 1e-9:
+            stopped = k * DT
+        if left_path is None and abs(pose[1]) > 0.05:
+            left_path = k * DT
+    return pose, min_gap, stopped, left_path
+
+
+@pytest.mark.parametrize("kin", ["diff_drive", "legged"])
+def test_steps_around_a_person_who_stays_in_the_way(kin: str) -> None:
+    """Blocked for detour_after s, a robot that turns on the spot detours and reaches the goal."""
+    pp = _pp()
+    pose, min_gap, stopped, left_path = _drive_past_standing_person(pp, kin)
+    assert pose[0] == pytest.approx(8.0, abs=0.06) and abs(pose[1]) < 0.06  # at the goal
+    assert min_gap > 0.0  # never touched the person
+    assert stopped is not None and left_path is not None
+    assert left_path >= stopped + pp.params.detour_after - DT  # it waited first
+
+
+def test_without_detour_the_robot_waits_for_good() -> None:
+    pose, min_gap, _, left_path = _drive_past_standing_person(_pp(detour_after=None), "diff_drive")
+    assert pose[0] < 3.0 - RADIUS - 0.3 and left_path is None and min_gap > 0.05
+
+
+@pytest.mark.parametrize("kin", ["legged", "diff_drive"])
+def test_backs_off_when_no_side_is_free(kin: str) -> None:
+    """Returns all around the front half: a robot that can reverse backs off, others wait."""
+    lim = DRIVES[kin]
+    pp = _pp()
+    angles = np.linspace(-math.pi, math.pi, 360, endpoint=False)
+    ranges = np.where(np.abs(angles) < 1.75, RADIUS + 0.1, 8.0)  # front and sides, 0.1 m away
+    path = _line(0.0, 5.0)
+    cmds = []
+    for k in range(30):
+        obs = dataclasses.replace(_obs([0, 0, 0], path, limits=lim, kinematics=kin,
+                                       ranges=ranges, angles=angles), time=k * DT)
+        cmds.append(pp.compute(obs))
+    first_reverse = next((k for k, c in enumerate(cmds) if c[0] < 0), None)
+    if lim.vx_min < 0:
+        assert first_reverse is not None
+        assert first_reverse * DT >= pp.params.detour_after - 1e-9  # it waited first
+        assert all(c[0] <= 0 and c[2] == 0 for c in cmds[first_reverse:])  # straight back
+    else:
+        assert first_reverse is None and all(c[0] == 0 for c in cmds)

@@ -73,9 +73,11 @@ def _drive(pose: np.ndarray, cmd: np.ndarray, world: OccupancyGrid) -> tuple[np.
     return new, False
 
 
-def _stack(**kw: object) -> NavigationStack:
+def _stack(local: PurePursuitPlanner | None = None, **kw: object) -> NavigationStack:
     kw.setdefault("scan_range_max", RANGE_MAX)
-    return NavigationStack(AStarPlanner(), PurePursuitPlanner(), robot_radius=RADIUS, **kw)
+    return NavigationStack(
+        AStarPlanner(), local or PurePursuitPlanner(), robot_radius=RADIUS, **kw
+    )
 
 
 def _run(nav, static, world_at, start, goal, t_max):
@@ -133,7 +135,9 @@ def test_rotate_recovery_turns_a_full_circle_and_back_up_needs_a_free_rear() -> 
     static = OccupancyGrid.empty(10.0, 4.0, RES)
     # Boxed in front and behind: rotate runs, back_up is skipped (rear not free).
     boxed = _box(_box(static, 3.0, 3.4, 0.0, 4.0), 2.0, 2.2, 0.0, 4.0)
-    nav = _stack(**RECOVERY, recovery_behaviors=("rotate", "back_up"))
+    # a local planner that only waits (pure pursuit's own detour would drive along the walls)
+    waiting = PurePursuitPlanner(PurePursuitPlanner.Params(detour_after=None))
+    nav = _stack(waiting, **RECOVERY, recovery_behaviors=("rotate", "back_up"))
     yaws: list[float] = []
 
     def world_at(n: NavigationStack, t: float) -> OccupancyGrid:

@@ -1,4 +1,5 @@
 import itertools
+import re
 
 import numpy as np
 import pytest
@@ -106,8 +107,13 @@ def test_library_models_and_interactive_obstacles():
 def test_impossible_request_fails_clearly():
     tiny = {"type": "empty", "width": 3.0, "height": 3.0}
     far = {"type": "random", "min_goal_distance": 10.0}
-    with pytest.raises(SamplingError, match="min_goal_distance"):
+    with pytest.raises(SamplingError, match="min_goal_distance") as e:
         generator(far, {"type": "random", "static": 0, "dynamic": 0}, map_spec=tiny).episode(0)
+    # it says how far apart free positions can be: less than the 3 m room's diagonal (the
+    # walls and the jackal's radius + clearance take their share), more than its inner side
+    span = float(re.search(r"at most ([0-9.]+) m apart", str(e.value)).group(1))
+    inner = 3.0 - 2 * (load_robot("jackal").radius + 0.25)
+    assert inner < span < 3.0 * np.sqrt(2)
     crowded = {"type": "random", "static": 40, "dynamic": 0, "obstacle_clearance": 1.0}
     near = {"type": "random", "min_goal_distance": 1.0}
     with pytest.raises(SamplingError, match="obstacle"):

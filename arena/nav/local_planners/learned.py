@@ -169,7 +169,7 @@ class PolicyPlanner:
         self.beam_angles = np.zeros(0)
         self.range_max = 0.0
         if "lidar" in self.policy.keys:
-            beams = int(self.policy.shapes["lidar"][1])
+            beams = int(self.policy.shapes["lidar"][-1])
             laser = self.policy.meta.get("laser") or {}
             self.range_max = float(
                 laser.get("range_max", np.max(self.policy.arrays["high/lidar"]))
@@ -205,13 +205,14 @@ class PolicyPlanner:
         pol = self.policy
         out: dict[str, NDArray[np.float32]] = {}
         if "lidar" in pol.keys:
-            stack = pol.shapes["lidar"][0]
+            shape = pol.shapes["lidar"]  # (beams,), or (stack, beams) for stacked scans
+            stack = shape[0] if len(shape) == 2 else 1
             r = resample_scan(obs.scan_angles, obs.scan_ranges, self.beam_angles, self.range_max)
             if self._scans is None:
                 self._scans = np.repeat(r[None], stack, axis=0)
             else:
                 self._scans = np.concatenate([self._scans[1:], r[None]], axis=0)
-            out["lidar"] = self._scans.astype(np.float32)
+            out["lidar"] = self._scans.reshape(shape).astype(np.float32)
         pose = np.asarray(obs.pose, dtype=np.float64).reshape(3)
         if "goal" in pol.keys:
             goal = np.array([obs.goal_pose.x, obs.goal_pose.y])
