@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import ast
 import json
+import os
 import re
 import shlex
 import shutil
@@ -72,6 +73,17 @@ def _reduced(args: list[str]) -> list[str]:
         extra += ["--scale", BENCH_SCALES[args[1]]]
     return [*args, *extra]
 
+# The example plugin files of docs/plugins.md (blocks that start ``# NAME.py``), which README
+# commands name with ``--plugin``.
+GUIDE_FILES = {
+    block.splitlines()[0][2:]: block
+    for block in re.findall(
+        r"```python\n(.*?)```",
+        (Path(__file__).resolve().parents[1] / "docs" / "plugins.md").read_text(encoding="utf-8"),
+        flags=re.S,
+    )
+    if re.fullmatch(r"# \w+\.py", block.splitlines()[0])
+}
 EXPERIMENT = "name: my_experiment\nrobot: burger\nepisodes: 1\noutput: {video: false}\n"
 """The ``my_experiment.yaml`` the README's examples refer to."""
 
@@ -107,10 +119,12 @@ def _materialise(tokens: list[str], root: Path) -> None:
     ``path/to/X/…/N.json`` a scenario of the packaged ``corridor`` world; ``path/to/X`` (a
     folder) a copy of that world.
     """
-    for tok in tokens:
+    for i, tok in enumerate(tokens):
         value = tok.split("=", 1)[-1]
         if value.endswith("my_experiment.yaml") and not (root / value).exists():
             (root / value).write_text(EXPERIMENT)
+        if tok == "--plugin" and i + 1 < len(tokens) and tokens[i + 1] in GUIDE_FILES:
+            (root / tokens[i + 1]).write_text(GUIDE_FILES[tokens[i + 1]], encoding="utf-8")
         m = re.match(r"(path/to/[^/]+)(/.*)?$", value)
         if m is None:
             continue
@@ -123,6 +137,12 @@ def _materialise(tokens: list[str], root: Path) -> None:
             continue
         if not head.exists():
             shutil.copytree(WORLDS / "corridor", head)
+        # `--map path/to/world --scenario NAME`: the world holds scenarios/NAME.json
+        if "--scenario" in tokens:
+            name = tokens[tokens.index("--scenario") + 1]
+            scenario = head / "scenarios" / f"{name}.json"
+            if "/" not in name and not name.endswith(".json") and not scenario.exists():
+                shutil.copy(WORLDS / "corridor" / "scenarios" / "default.json", scenario)
         full = root / value
         if full.suffix == ".json" and not full.exists():
             full.parent.mkdir(parents=True, exist_ok=True)
@@ -171,6 +191,20 @@ def test_the_readme_has_commands_and_snippets():
     assert ["robots"] in COMMANDS
 
 
+@pytest.fixture
+def _restore_plugins(monkeypatch):
+    """Commands with ``--plugin`` register plugins in this process: remove them afterwards."""
+    from arena.plugins import PLUGINS_ENV, all_registries
+
+    monkeypatch.setenv(PLUGINS_ENV, os.environ.get(PLUGINS_ENV, ""))
+    before = {kind: set(reg.names()) for kind, reg in all_registries().items()}
+    yield
+    for kind, reg in all_registries().items():
+        for name in set(reg.names()) - before.get(kind, set()):
+            reg._entries.pop(name)
+
+
+@pytest.mark.usefixtures("_restore_plugins")
 def test_readme_commands_parse_and_validate(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr("arena.experiment.run_experiment", _first_episode)
