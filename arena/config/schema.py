@@ -11,8 +11,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, StrictInt
 
+from arena.core.names import RULE, SafeLabel
+from arena.core.rng import Seed
 from arena.crowd.simulator import PedestrianConfig
 from arena.learn.config import LearningConfig
 from arena.nav.stack import NavigationConfig
@@ -56,9 +58,15 @@ class EvaluationConfig(_Strict):
 class ExperimentConfig(_Strict):
     """One experiment: a robot, a map, a task, a crowd, a navigation stack, a simulator."""
 
-    name: str = Field("default", description="label for outputs")
-    seed: int = Field(0, ge=0, description="master seed: every random draw derives from it")
-    episodes: int = Field(1, ge=1, description="number of episodes")
+    name: SafeLabel = Field(
+        "default",
+        description=f"label for outputs, part of the run folder's name: {RULE} "
+        "('/' separates sub-folders)",
+    )
+    seed: Seed = Field(
+        0, description="master seed: every random draw derives from it; an int in [0, 2**63)"
+    )
+    episodes: StrictInt = Field(1, ge=1, description="number of episodes")
     robot: str = Field("jackal", description="robot preset name or path to a robot YAML")
     map: dict[str, Any] = Field(
         default_factory=lambda: {"type": "world", "name": "small_office"},

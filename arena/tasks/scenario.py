@@ -50,9 +50,12 @@ from pydantic import (
     StrictInt,
     StrictStr,
     ValidationError,
+    ValidationInfo,
+    field_validator,
     model_validator,
 )
 
+from arena.core import files
 from arena.core.errors import ConfigError, UnknownNameError, from_validation_error
 from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
@@ -65,6 +68,7 @@ from arena.tasks.episode import (
     AgentSpawn,
     Episode,
     RobotSpawn,
+    speed_range_problem,
 )
 
 DEFAULT_VMAX = 0.3
@@ -145,6 +149,31 @@ class ObstacleEntry(BaseModel):
         return out
 
 
+PARAM_FIELDS = (
+    "vmax",
+    "chatting_probability",
+    "tell_story_probability",
+    "group_talking_probability",
+    "talking_and_walking_probability",
+    "requesting_service_probability",
+    "requesting_guide_probability",
+    "requesting_follower_probability",
+    "max_talking_distance",
+    "max_servicing_radius",
+    "talking_base_time",
+    "tell_story_base_time",
+    "group_talking_base_time",
+    "talking_and_walking_base_time",
+    "receiving_service_base_time",
+    "requesting_service_base_time",
+    "force_factor_desired",
+    "force_factor_obstacle",
+    "force_factor_social",
+    "force_factor_robot",
+)
+"""The pedestrian keys that take a number or a ``[lo, hi]`` range (:data:`Param`)."""
+
+
 class Pedestrian(BaseModel):
     """A dynamic obstacle (pedsim pedestrian) with Arena's optional per-ped overrides.
 
@@ -186,6 +215,30 @@ class Pedestrian(BaseModel):
     force_factor_obstacle: Param | None = None
     force_factor_social: Param | None = None
     force_factor_robot: Param | None = None
+
+    @field_validator(*PARAM_FIELDS)
+    @classmethod
+    def _plausible(cls, v: Any, info: ValidationInfo) -> Any:
+        """Ranges run low to high, nothing is negative, probabilities are at most 1, speeds human.
+
+        A reversed ``[hi, lo]`` would reach numpy as a negative spread ("scale < 0") only when
+        the episode is drawn; a vmax of 1e6 m/s is a typo, not a person.
+        """
+        if v is None:
+            return v
+        lo, hi = v if isinstance(v, tuple) else (v, v)
+        name = info.field_name or ""
+        if lo > hi:
+            raise ValueError(f"a range must be [low, high], got {list(v)}")
+        if name == "vmax":
+            problem = speed_range_problem(lo, hi)
+            if problem:
+                raise ValueError(f"vmax {problem}")
+        elif lo < 0:
+            raise ValueError(f"must be >= 0, got {v!r}")
+        elif name.endswith("_probability") and hi > 1:
+            raise ValueError(f"a probability must lie in [0, 1], got {v!r}")
+        return v
 
     @property
     def kind(self) -> str:
@@ -268,16 +321,13 @@ def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
         source: the file name used in error messages.
 
     Raises:
-        ConfigError: malformed JSON (with line and column), a wrong type or unknown key (with
-            the key path, e.g. ``obstacles.dynamic[3].waypoints``), or an obstacle model that is
-            not in the library (with the closest name).
+        ConfigError: malformed JSON (with line and column; duplicate keys and deep nesting
+            included, see :func:`arena.core.files.parse_json`), a wrong type or unknown key
+            (with the key path, e.g. ``obstacles.dynamic[3].waypoints``), an obstacle model
+            that is not in the library (with the closest name), a robot whose start is its goal
+            or two pedestrians on one spot (see :func:`check_layout`).
     """
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise ConfigError(
-            f"malformed JSON at line {e.lineno}, column {e.colno}: {e.msg}", source=source
-        ) from None
+    data = files.parse_json(text, source=source)
     try:
         scenario = Scenario.model_validate(data)
     except ValidationError as e:
@@ -288,17 +338,101 @@ def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
                 obstacle_model(_model_name(o.model))
             except UnknownNameError as e:
                 raise e.located(source=source, prefix=f"obstacles.{group}[{i}].model") from None
+    check_layout(scenario, source=source)
     return scenario
+
+
+MIN_GOAL_DISTANCE = 0.3
+"""m; a robot goal closer than this to its start (the default ``task.goal_radius``) would be
+reached at the first step: :func:`check_layout` refuses it as ``start == goal``."""
+
+
+def check_layout(
+    scenario: Scenario, *, goal_radius: float = MIN_GOAL_DISTANCE, source: str | None = None
+) -> None:
+    """Refuse what no map can make valid: start == goal, two people on one spot.
+
+    A goal within ``goal_radius`` of its start, or two pedestrians whose bodies (radius
+    :data:`DEFAULT_PED_RADIUS`) overlap at their starts.
+
+    Raises:
+        ConfigError: naming the entry (``robots[0].goal``, ``obstacles.dynamic[4].pos``).
+    """
+    for i, r in enumerate(scenario.robots):
+        d = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
+        if d <= goal_radius:
+            raise ConfigError(
+                f"the goal ({r.goal[0]:g}, {r.goal[1]:g}) is {d:.3g} m from the start: start == "
+                f"goal within the goal radius {goal_radius:g} m (the episode would end at once)",
+                source=source, path=f"robots[{i}].goal",
+            )
+    peds = scenario.obstacles.dynamic
+    if len(peds) > 1:
+        from scipy.spatial import cKDTree
+
+        xy = np.array([p.pos[:2] for p in peds], dtype=np.float64)
+        pairs = cKDTree(xy).query_pairs(2 * DEFAULT_PED_RADIUS * (1 - 1e-9))
+        if pairs:
+            i, j = min(pairs, key=lambda ij: (ij[1], ij[0]))  # the first entry that collides
+            gap = float(np.hypot(*(xy[j] - xy[i])))
+            raise ConfigError(
+                f"starts {gap:.3g} m from obstacles.dynamic[{i}] ({peds[i].name!r}): two "
+                f"people on one spot (bodies of radius {DEFAULT_PED_RADIUS:g} m need "
+                f">= {2 * DEFAULT_PED_RADIUS:g} m between centres)",
+                source=source, path=f"obstacles.dynamic[{j}].pos",
+            )
+
+
+def check_robot_bodies(
+    spawns: Sequence[RobotSpawn],
+    grid: OccupancyGrid,
+    obstacles: Sequence[Obstacle],
+    *,
+    source: str | None = None,
+) -> None:
+    """Check each robot's real footprint at its start and goal against walls and obstacles.
+
+    Uses the simulator's own contact tests: a point check misses a body half inside a shelf.
+
+    Args:
+        spawns: the robots, in scenario order (``robots[k]``).
+        grid: the map.
+        obstacles: the placed obstacles to test against.
+        source: the scenario file, for messages.
+
+    Raises:
+        ConfigError: ``robots[k].start`` (or ``.goal``) and what the body overlaps.
+    """
+    from arena.sim.native2d.collisions import (
+        Footprint,
+        ObstacleIndex,
+        first_obstacle_hit,
+        hits_grid,
+    )
+    from arena.sim.state import StaticWorld
+
+    index = ObstacleIndex.build(StaticWorld.build(grid, tuple(obstacles)))
+    for k, spawn in enumerate(spawns):
+        model = spawn.model
+        fp = Footprint.make(model.footprint_polygon(), model.circumscribed_radius)
+        for key, pose in (("start", spawn.start), ("goal", spawn.goal)):
+            p = np.array([pose.x, pose.y, pose.theta], dtype=np.float64)
+            where = f"({pose.x:g}, {pose.y:g}, {pose.theta:g})"
+            body = f"the body of {model.name!r} (reach {fp.reach:.2f} m) at {where}"
+            if hits_grid(grid, fp, p):
+                raise ConfigError(f"{body} overlaps a wall or leaves the map",
+                                  source=source, path=f"robots[{k}].{key}")
+            j = first_obstacle_hit(index, fp, p)
+            if j >= 0:
+                ob = obstacles[j]
+                raise ConfigError(f"{body} overlaps obstacle {ob.name!r} ({ob.model})",
+                                  source=source, path=f"robots[{k}].{key}")
 
 
 def load_scenario(path: str | Path) -> Scenario:
     """Read an Arena scenario JSON file (see :func:`parse_scenario` for the errors)."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as e:
-        raise ConfigError(f"cannot read scenario file: {e.strerror}", source=str(p)) from None
-    return parse_scenario(text, source=str(p))
+    return parse_scenario(files.read_text(p, what="scenario file"), source=str(p))
 
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:

@@ -35,12 +35,12 @@ import json
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError, field_validator
 
 from arena.config.loader import merge
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, from_validation_error
-from arena.core.rng import child_seed
+from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, resolve_world
 from arena.tasks.datafiles import find_data_file, read_yaml_any
 
@@ -67,7 +67,9 @@ class RandomClass(_Arena):
 class RandomBlock(_Arena):
     """Arena's ``RANDOM`` block."""
 
-    seed: int | None = Field(None, description="replaces the stage seed when >= 0 (-1: unset)")
+    seed: StrictInt | None = Field(
+        None, ge=-1, le=MAX_SEED, description="replaces the stage seed when >= 0 (-1: unset)"
+    )
     static: RandomClass | None = None
     interactive: RandomClass | None = None
     dynamic: RandomClass | None = None
@@ -120,7 +122,7 @@ class SuiteStage(_Arena):
     tm_obstacles: str = Field("random", description="obstacle task mode")
     config: TaskOverlay = Field(default_factory=TaskOverlay, description="Arena overlay")
     task: dict[str, Any] | None = Field(None, description="overlay in our task format")
-    seed: int | None = Field(None, ge=0, description="stage seed; default from SHA-1")
+    seed: Seed | None = Field(None, description="stage seed; default from SHA-1")
     timeout: float | None = Field(None, gt=0, description="s per episode; default: the run's")
     map_per_episode: bool = Field(
         True, description="a generated map gets a new instance every episode"
