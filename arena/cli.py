@@ -638,7 +638,10 @@ def main() -> None:
     except ArenaError as e:
         if os.environ.get("ARENA_DEBUG"):
             raise
-        err_console.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+        from rich.markup import escape  # messages hold key paths like [min, max]: not markup
+
+        err_console.print(f"[bold red]error:[/] {escape(str(e))}", highlight=False,
+                          soft_wrap=True)
         sys.exit(2)
 
 

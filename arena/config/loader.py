@@ -123,7 +123,7 @@ def load_config(path: str | Path | None = None, overrides: Sequence[str] = ()) -
             )
             if (
                 err.path == key
-                or err.path.startswith(key + ".")
+                or err.path.startswith((key + ".", key + "["))
                 or key.startswith(err.path + ".")
                 or same_block
             ):

@@ -19,9 +19,12 @@ from __future__ import annotations
 
 import json
 import os
+import zipfile
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from arena.core.errors import ConfigError
@@ -252,6 +255,51 @@ def read_json(path: str | os.PathLike[str], *, what: str = "file") -> Any:
     return parse_json(read_text(path, what=what), source=str(path))
 
 
+# -- numpy archives -----------------------------------------------------------------------------
+def read_npz(
+    path: str | os.PathLike[str], required: Sequence[str], *, what: str = "weights file"
+) -> dict[str, np.ndarray]:
+    """Every array of an ``.npz`` archive, read without unpickling anything.
+
+    Args:
+        path: the file.
+        required: array names that must be present.
+        what: what the file is, for messages.
+
+    Raises:
+        ConfigError: missing file, not an ``.npz`` archive, pickled (object) arrays, a missing
+            array, or non-finite numbers in a numeric array.
+    """
+    p = Path(path)
+    source = str(p)
+    if not p.is_file():
+        raise ConfigError(f"{what} not found", source=source)
+    try:
+        with p.open("rb") as f:
+            magic = f.read(6)
+        if not magic.startswith(b"PK"):  # an .npz is a zip archive
+            kind = "a single .npy array" if magic == b"\x93NUMPY" else "not a zip archive"
+            raise ConfigError(f"not an .npz archive ({kind}); expected a {what}", source=source)
+        with np.load(p, allow_pickle=False) as z:
+            arrays = {k: np.asarray(z[k]) for k in z.files}
+    except ValueError as e:
+        text = "holds pickled Python objects, which are never loaded" if "pickle" in str(e) \
+            else f"not a readable .npz archive ({e})"
+        raise ConfigError(f"{text}; expected a {what}", source=source) from None
+    except (OSError, EOFError, zipfile.BadZipFile, KeyError) as e:
+        raise ConfigError(f"not a readable .npz archive ({e}); expected a {what}",
+                          source=source) from None
+    missing = [k for k in required if k not in arrays]
+    if missing:
+        raise ConfigError(
+            f"lacks the arrays {missing} (has {sorted(arrays)}); not a {what}", source=source
+        )
+    for k, a in arrays.items():
+        if a.dtype.kind in "fc" and not np.all(np.isfinite(a)):
+            raise ConfigError(f"array {k!r} holds NaN or infinite values", source=source)
+    return arrays
+
+
 # -- output folders -----------------------------------------------------------------------------
 def make_dir(path: str | os.PathLike[str], *, what: str = "output folder") -> Path:
     """Create a folder (and its parents) to write into, or raise a one-line error.
@@ -280,6 +328,7 @@ __all__ = [
     "parse_json",
     "parse_yaml",
     "read_json",
+    "read_npz",
     "read_text",
     "read_yaml",
     "yaml_problem",

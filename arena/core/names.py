@@ -59,8 +59,8 @@ def check_name(
     """
     problem = name_problem(value)
     if problem is not None:
-        raise ConfigError(f"{what} {_shown(value)} {problem} (use {RULE})", source=source,
-                          path=path)
+        raise ConfigError(f"{what} {_shown(value)} {problem} (use {RULE})".lstrip(),
+                          source=source, path=path)
     return str(value)
 
 
@@ -68,13 +68,13 @@ def check_label(
     value: Any, what: str, *, source: str | None = None, path: str | None = None
 ) -> str:
     """Like :func:`check_name` for ``/``-separated names (a sub-folder: ``suite/stage``)."""
-    if not isinstance(value, str):
+    if not isinstance(value, str) or "/" not in value:
         return check_name(value, what, source=source, path=path)
     for part in value.split("/"):
         if name_problem(part) is not None:
             raise ConfigError(
                 f"{what} {_shown(value)}: part {_shown(part)} {name_problem(part)} "
-                f"(use names of {RULE}, separated by '/')",
+                f"(use names of {RULE}, separated by '/')".lstrip(),
                 source=source, path=path,
             )
     return value
@@ -90,10 +90,10 @@ def _validated(check: Any, what: str) -> Any:
     return AfterValidator(validate)
 
 
-SafeName = Annotated[str, _validated(check_name, "name")]
+SafeName = Annotated[str, _validated(check_name, "")]
 """A pydantic field type for a name that becomes a file name (see :func:`check_name`)."""
 
-SafeLabel = Annotated[str, _validated(check_label, "name")]
+SafeLabel = Annotated[str, _validated(check_label, "")]
 """A pydantic field type for ``/``-separated names (see :func:`check_label`)."""
 
 __all__ = [

@@ -27,7 +27,8 @@ from typing import Any
 import pyarrow as pa
 
 from arena import __version__
-from arena.core.errors import ArenaError
+from arena.core.errors import ArenaError, ConfigError
+from arena.core.names import check_name
 from arena.eval.io import save_record
 from arena.eval.record import EpisodeRecord
 
@@ -82,15 +83,14 @@ def _write_json(path: Path, data: Any) -> None:
     _atomic_write(path, write)
 
 
-def _check_name(name: str, what: str) -> None:
-    if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
-        raise ArenaError(f"{what} name {name!r} cannot be a folder name")
-
-
 def episode_stem(run: Path, contestant: str, stage: str, episode: int) -> Path:
-    """``<run>/episodes/<contestant>/<stage>/<episode:04d>`` (no suffix)."""
-    _check_name(contestant, "contestant")
-    _check_name(stage, "stage")
+    """``<run>/episodes/<contestant>/<stage>/<episode:04d>`` (no suffix).
+
+    Raises:
+        ConfigError: a name that cannot be a folder name (:func:`arena.core.names.check_name`).
+    """
+    check_name(contestant, "contestant name")
+    check_name(stage, "stage name")
     return Path(run) / EPISODES / contestant / stage / f"{int(episode):04d}"
 
 
@@ -202,11 +202,36 @@ def load_rows(run: str | Path) -> list[dict[str, Any]]:
     rows = []
     for p in _row_files(Path(run)):
         try:
-            rows.append(json.loads(p.read_text()))
-        except (OSError, json.JSONDecodeError) as e:
+            row = json.loads(p.read_text())
+        except (OSError, ValueError) as e:  # ValueError: JSON errors, bad UTF-8
             raise ArenaError(f"{p}: unreadable episode row ({e})") from None
+        rows.append(_checked_row(Path(run), p, row))
     rows.sort(key=lambda r: (str(r["contestant"]), str(r["stage"]), int(r["episode"])))
     return rows
+
+
+def _checked_row(run: Path, path: Path, row: Any) -> dict[str, Any]:
+    """A stored row, checked: its names become paths in reports.
+
+    A tampered or foreign run folder must not name ``../../X``: the names must be the folders
+    the row lies in, and the record the parquet file beside it.
+    """
+    source = str(path)
+    if not isinstance(row, dict):
+        raise ConfigError("an episode row must be a JSON object", source=source)
+    for key, folder in (("contestant", path.parent.parent.name), ("stage", path.parent.name)):
+        check_name(row.get(key), f"{key} name", source=source, path=key)
+        if row[key] != folder:
+            raise ConfigError(f"{row[key]!r} differs from the folder it lies in ({folder!r})",
+                              source=source, path=key)
+    if not isinstance(row.get("episode"), int) or isinstance(row["episode"], bool):
+        raise ConfigError(f"expected an integer, got {row.get('episode')!r}", source=source,
+                          path="episode")
+    record = row.get("record") or ""
+    if record and record != path.with_suffix(".parquet").relative_to(run).as_posix():
+        raise ConfigError(f"{record!r} is not this episode's record file", source=source,
+                          path="record")
+    return row
 
 
 def metric_columns(rows: Iterable[Mapping[str, Any]]) -> list[str]:

@@ -362,7 +362,7 @@ def save_map(
     pixels = np.full(grid.data.shape, _SAVE_UNKNOWN, dtype=np.uint8)
     pixels[grid.data == FREE] = _SAVE_FREE
     pixels[grid.data == OCCUPIED] = _SAVE_OCCUPIED
-    yaml_path.parent.mkdir(parents=True, exist_ok=True)
+    files.make_dir(yaml_path.parent, what="map folder")
     Image.fromarray(np.flipud(pixels), mode="L").save(
         yaml_path.parent / name, format=_FORMATS[image_format]
     )

@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Protocol
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from arena.core.errors import ConfigError, MapError
 from arena.core.registry import Registry
@@ -106,6 +106,15 @@ class WorldMap:
         model_config = ConfigDict(frozen=True, extra="forbid")
         name: str = Field(description="packaged world name or path to a world folder")
 
+        @field_validator("name")
+        @classmethod
+        def _exists(cls, v: str) -> str:
+            try:  # when the config is loaded, so that the error names map.name
+                resolve_world(v)
+            except ConfigError as e:
+                raise ValueError(e.message) from None
+            return v
+
     def __init__(self, params: Params) -> None:
         self.params = params
         self._result: MapResult | None = None
@@ -166,9 +175,10 @@ def write_world(result: MapResult, folder: str | Path) -> dict[str, Path]:
     """
     import json
 
+    from arena.core.files import make_dir
     from arena.maps.io import save_map
 
-    folder = Path(folder)
+    folder = make_dir(folder, what="world folder")
     yaml_path = save_map(result.grid, folder / "map" / "map.yaml", image_format="png")
     static = [
         {"name": o.name, "model": o.model, "pos": [round(float(v), 6) for v in o.pose]}

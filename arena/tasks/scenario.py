@@ -64,6 +64,7 @@ from arena.maps.obstacles import make_obstacle, obstacle_model
 from arena.robots.model import RobotModel
 from arena.sim.state import Obstacle
 from arena.tasks.episode import (
+    MAX_PERSON_SPEED,
     WAYPOINT_LOOP,
     AgentSpawn,
     Episode,
@@ -231,6 +232,9 @@ class Pedestrian(BaseModel):
         if lo > hi:
             raise ValueError(f"a range must be [low, high], got {list(v)}")
         if name == "vmax":
+            if not isinstance(v, tuple) and speed_range_problem(lo, hi):
+                raise ValueError(f"must lie in [0, {MAX_PERSON_SPEED:g}] m/s (a person's walking "
+                                 f"speed), got {v!r}")
             problem = speed_range_problem(lo, hi)
             if problem:
                 raise ValueError(f"vmax {problem}")

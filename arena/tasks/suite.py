@@ -40,6 +40,7 @@ from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError, f
 from arena.config.loader import merge
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, from_validation_error
+from arena.core.names import RULE, SafeName
 from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, resolve_world
 from arena.tasks.datafiles import find_data_file, read_yaml_any
@@ -112,7 +113,7 @@ class TaskOverlay(_Arena):
 class SuiteStage(_Arena):
     """One stage of a suite."""
 
-    name: str = Field(description="stage name (reports, output folders)")
+    name: SafeName = Field(description=f"stage name (reports, output folders): {RULE}")
     episodes: int = Field(ge=0, description="episodes before scale_episodes")
     robot: str | None = Field(None, description="robot preset or YAML; None: the run's")
     map: str | dict[str, Any] | None = Field(
@@ -129,16 +130,34 @@ class SuiteStage(_Arena):
     )
 
 
+def _unique_names(items: list[Any], what: str) -> list[Any]:
+    """Refuse two entries with one name: they would share one results folder."""
+    seen: dict[str, int] = {}
+    for i, item in enumerate(items):
+        if item.name in seen:
+            raise ValueError(
+                f"[{seen[item.name]}] and [{i}] are both named {item.name!r}; {what} names must "
+                "be unique (each names a results folder: two would mix their results)"
+            )
+        seen[item.name] = i
+    return items
+
+
 class SuiteFile(_Arena):
     """``suites/<name>.yaml``."""
 
-    stages: list[SuiteStage] = Field(min_length=1)
+    stages: list[SuiteStage] = Field(min_length=1, description="stages, unique names")
+
+    @field_validator("stages")
+    @classmethod
+    def _unique(cls, v: list[SuiteStage]) -> list[SuiteStage]:
+        return _unique_names(v, "stage")
 
 
 class Contestant(_Arena):
     """One contestant: a navigation stack."""
 
-    name: str
+    name: SafeName = Field(description=f"contestant name (reports, output folders): {RULE}")
     local_planner: str = Field(description="local planner name")
     inter_planner: str = Field("bypass", description="Arena's intermediate planner")
     params: dict[str, Any] = Field(
@@ -151,7 +170,12 @@ class Contestant(_Arena):
 class ContestFile(_Arena):
     """``contests/<name>.yaml``."""
 
-    contestants: list[Contestant] = Field(min_length=1)
+    contestants: list[Contestant] = Field(min_length=1, description="contestants, unique names")
+
+    @field_validator("contestants")
+    @classmethod
+    def _unique(cls, v: list[Contestant]) -> list[Contestant]:
+        return _unique_names(v, "contestant")
 
 
 class SuiteRef(_Arena):
