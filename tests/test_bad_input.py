@@ -419,3 +419,34 @@ def test_malformed_input_gives_one_line_error(
         assert frag.replace("{d}", str(corpus)) in lines[0], lines[0]
     assert not any(tmp_path.iterdir()), "a refused input wrote files"
 
+
+
+# -- documented legal inputs next to the limits ------------------------------------------------
+def test_limits_themselves_are_legal(tmp_path):
+    from arena.config import load_config
+    from arena.core.rng import MAX_SEED
+    from arena.tasks.scenario import parse_scenario
+
+    cfg = load_config(None, [f"seed={MAX_SEED}", "name=suite/stage-1.v2",
+                             "task.obstacles.agent_speed=[0, 3]", "map.type=empty",
+                             "map.width=350", "map.height=350", "map.resolution=0.05"])
+    assert (cfg.seed, cfg.name) == (MAX_SEED, "suite/stage-1.v2")
+    apart = _scenario(peds=[{"name": "a", "pos": [5.0, 2.0, 0.0], "vmax": [0.0, 3.0]},
+                            {"name": "b", "pos": [5.6, 2.0, 0.0], "vmax": 3}])
+    sc = parse_scenario(apart, source="ok.json")  # bodies touching, not overlapping
+    assert [p.vmax for p in sc.obstacles.dynamic] == [(0.0, 3.0), 3.0]
+
+
+def test_robot_body_clear_of_a_shelf_is_accepted(tmp_path):
+    # jackal's footprint reaches 0.21 m ahead; the shelf's face is at x = 5.2
+    scenario = tmp_path / "clear.json"
+    scenario.write_text(_scenario(start=[5.45, 5.0, 0.0],
+                                  static=[{"name": "s", "model": "shelf", "pos": [5.0, 5.0, 0.0]}]))
+    from arena.config import load_config
+    from arena.robots.presets import load_robot
+    from arena.tasks.generator import TaskGenerator
+
+    block = json.dumps({"type": "scenario", "file": str(scenario)})
+    cfg = load_config(None, [*EMPTY_MAP, f"task.robots={block}", f"task.obstacles={block}"])
+    ep = TaskGenerator.from_config(cfg, [load_robot(cfg.robot)]).episode(0)
+    assert ep.robots[0].start.x == 5.45

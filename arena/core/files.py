@@ -53,13 +53,13 @@ def read_text(path: str | os.PathLike[str], *, what: str = "file") -> str:
     """
     p = Path(path)
     source = str(p)
-    if not p.exists():
-        raise ConfigError(f"{what} not found", source=source)
-    if p.is_dir():
-        raise ConfigError(f"expected a {what}, found a folder", source=source)
-    if not p.is_file():
-        raise ConfigError(f"expected a {what}, found a device or pipe", source=source)
-    try:
+    try:  # exists() itself raises for a name too long
+        if not p.exists():
+            raise ConfigError(f"{what} not found", source=source)
+        if p.is_dir():
+            raise ConfigError(f"expected a {what}, found a folder", source=source)
+        if not p.is_file():
+            raise ConfigError(f"expected a {what}, found a device or pipe", source=source)
         if p.stat().st_size > MAX_FILE_BYTES:
             raise ConfigError(
                 f"{what} is larger than {MAX_FILE_BYTES // 2**20} MiB", source=source
@@ -272,9 +272,9 @@ def read_npz(
     """
     p = Path(path)
     source = str(p)
-    if not p.is_file():
-        raise ConfigError(f"{what} not found", source=source)
     try:
+        if not p.is_file():
+            raise ConfigError(f"{what} not found", source=source)
         with p.open("rb") as f:
             magic = f.read(6)
         if not magic.startswith(b"PK"):  # an .npz is a zip archive
@@ -309,9 +309,9 @@ def make_dir(path: str | os.PathLike[str], *, what: str = "output folder") -> Pa
             folder cannot be created (permissions, read-only file system ...).
     """
     p = Path(path)
-    if p.exists() and not p.is_dir():
-        raise ConfigError(f"{what}: exists and is not a folder", source=str(p))
-    try:
+    try:  # exists() itself raises for a name too long
+        if p.exists() and not p.is_dir():
+            raise ConfigError(f"{what}: exists and is not a folder", source=str(p))
         p.mkdir(parents=True, exist_ok=True)
     except OSError as e:
         raise ConfigError(f"{what}: cannot create it: {e.strerror or e}", source=str(p)) from None

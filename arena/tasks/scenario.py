@@ -32,6 +32,13 @@ instead of an error, so that every file Arena ships loads unchanged:
 * A pedestrian with no waypoints stands at its start position.
 * Legacy model names ending in ``.yaml`` (``shelf.yaml``) name the library model ``shelf``.
 * An unknown pedestrian ``type`` is treated as adult (what Arena's crowd model does).
+
+Refused although Arena would load them (no published file has them; each would fail late or
+make no sense): a key given twice, a ``[hi, lo]`` range, a negative parameter, a probability
+above 1, a ``vmax`` outside [0, 3] m/s, a robot goal within the goal radius of its start, two
+pedestrians overlapping at their starts (:func:`check_layout`). Against the episode's map the
+task modes also refuse a robot whose real footprint overlaps a wall or an obstacle at its start
+or goal (:func:`check_robot_bodies`; ``check_map: false`` turns the map checks off).
 """
 
 from __future__ import annotations

@@ -39,13 +39,18 @@ from arena.tasks.sampling import (
 BOX = "box"
 """Pseudo-model: a cuboid with random edge lengths."""
 
+MAX_COUNT = 10_000
+"""Most obstacles (or people) of one class in an episode: far beyond the dense crowds the 2-D
+simulation is used for (1,000 people), while ``dynamic=1e9`` is refused at once instead of
+allocating gigabytes."""
+
 
 class Count(BaseModel):
     """How many of one obstacle class: ``n``, ``[min, max]`` or ``{min, max, models}``."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
-    min: int = Field(0, ge=0)
-    max: int = Field(0, ge=0)
+    min: int = Field(0, ge=0, le=MAX_COUNT, description=f"fewest; 0 to {MAX_COUNT:,}")
+    max: int = Field(0, ge=0, le=MAX_COUNT, description=f"most; 0 to {MAX_COUNT:,}")
     models: list[str] = Field(
         default_factory=lambda: [BOX], description="models drawn uniformly (static classes)"
     )
