@@ -91,7 +91,7 @@ def decode_text(data: bytes, *, source: str | None = None) -> str:
 
 
 # -- YAML ---------------------------------------------------------------------------------------
-class StrictLoader(yaml.SafeLoader):
+class StrictLoader(yaml.SafeLoader):  # type: ignore[misc]  # PyYAML ships no type stubs
     """PyYAML's safe loader with duplicate keys, deep nesting and alias bombs refused."""
 
     def __init__(self, stream: str) -> None:
@@ -184,7 +184,8 @@ def _mapping_no_duplicates(loader: StrictLoader, node: yaml.MappingNode) -> dict
                 None, None, f"duplicate key {key!r}", key_node.start_mark
             )
         seen.add(key)
-    return loader.construct_mapping(node, deep=True)  # flattens merge keys, last one wins
+    out: dict[Any, Any] = loader.construct_mapping(node, deep=True)  # merges <<, last wins
+    return out
 
 
 StrictLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _mapping_no_duplicates)

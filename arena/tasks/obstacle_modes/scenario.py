@@ -13,7 +13,8 @@ from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import AgentSpawn
 from arena.tasks.robot_modes.scenario import ScenarioFile, ScenarioRobots
-from arena.tasks.scenario import check_robot_bodies, scenario_agents, scenario_obstacles
+from arena.tasks.scenario import scenario_agents, scenario_obstacles
+from arena.tasks.scenario_checks import check_robot_bodies
 
 
 @register_mode("obstacles", "scenario", tags=("file",))

@@ -15,13 +15,8 @@ from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, SingleGoal, register_mode
 from arena.tasks.episode import RobotSpawn
 from arena.tasks.robot_modes.random import robot_name
-from arena.tasks.scenario import (
-    Scenario,
-    check_layout,
-    check_robot_bodies,
-    load_scenario,
-    validate_against_map,
-)
+from arena.tasks.scenario import Scenario, load_scenario
+from arena.tasks.scenario_checks import check_layout, check_robot_bodies, validate_against_map
 
 
 class ScenarioFile:
