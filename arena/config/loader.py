@@ -21,7 +21,7 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
-from arena.config.schema import ExperimentConfig
+from arena.config.schema import ExperimentConfig, non_finite_key
 from arena.core import files
 from arena.core.errors import ConfigError, UnknownNameError, from_validation_error, shorten
 
@@ -132,6 +132,10 @@ def load_config(path: str | Path | None = None, overrides: Sequence[str] = ()) -
                 )
         return err
 
+    found = non_finite_key(data)
+    if found is not None:
+        raise located(ConfigError(f"must be a finite number, got {found[1]}", source=source,
+                                  path=found[0]))
     try:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as e:

@@ -8,10 +8,11 @@ error names the file and the key path.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, StrictInt
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, model_validator
 
 from arena.core.names import RULE, SafeLabel
 from arena.core.rng import Seed
@@ -19,6 +20,25 @@ from arena.crowd.simulator import PedestrianConfig
 from arena.learn.config import LearningConfig
 from arena.nav.stack import NavigationConfig
 from arena.tasks.config import TaskConfig
+
+
+def non_finite_key(data: Any) -> tuple[str, float] | None:
+    """The key path and value of the first infinite or NaN number in a config (``None``: none).
+
+    No setting of an experiment means "unbounded" by infinity (``task.timeout: .inf`` would run
+    an episode forever), and NaN compares false with every bound, so configs hold finite numbers
+    only. Checked on the raw data, so that plugin blocks (plain mappings here) are covered too.
+    """
+    stack: list[tuple[str, Any]] = [("", data)]
+    while stack:
+        path, value = stack.pop()
+        if isinstance(value, float) and not math.isfinite(value):
+            return path, value
+        if isinstance(value, dict):
+            stack.extend((f"{path}.{k}" if path else str(k), v) for k, v in value.items())
+        elif isinstance(value, list | tuple):
+            stack.extend((f"{path}[{i}]", v) for i, v in enumerate(value))
+    return None
 
 
 class _Strict(BaseModel):
@@ -84,3 +104,11 @@ class ExperimentConfig(_Strict):
     learning: LearningConfig = Field(
         default_factory=LearningConfig, description="RL environments (arena.learn)"
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _finite(cls, data: Any) -> Any:
+        found = non_finite_key(data)
+        if found is not None:
+            raise ValueError(f"{found[0]}: must be a finite number, got {found[1]}")
+        return data
