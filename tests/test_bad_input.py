@@ -109,6 +109,8 @@ FILES: dict[str, str | bytes] = {
     "robot_bomb.yaml": BURGER + BOMB.replace("a:", "zz_a:", 1),
     "robot_radius.yaml": BURGER.replace("radius: 0.113", "radius: -0.1"),
     "robot_unknown.yaml": BURGER + "wheels: 4\n",
+    "robot_beams.yaml": BURGER.replace("num_beams: 360", "num_beams: 1000000000"),
+    "robot_range.yaml": BURGER.replace("range_max: 3.5", "range_max: .inf"),
     # maps (map.pgm is written by the fixture)
     "map_origin.yaml": MAP_YAML.replace("[0.0, 0.0, 0.0]", "[1.0e20, 0.0, 0.0]"),
     "map_dup.yaml": MAP_YAML + "resolution: 0.1\n",
@@ -326,6 +328,10 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("robot_bomb", ["run", "robot={d}/robot_bomb.yaml"], ["robot_bomb.yaml", "1,000,000"]),
     ("robot_radius", ["run", "robot={d}/robot_radius.yaml"], ["robot_radius.yaml", "radius"]),
     ("robot_unknown", ["run", "robot={d}/robot_unknown.yaml"], ["robot_unknown.yaml", "wheels"]),
+    ("robot_beams", ["run", "robot={d}/robot_beams.yaml"],
+     ["robot_beams.yaml", "laser.num_beams", "10000"]),
+    ("robot_range", ["run", "robot={d}/robot_range.yaml"],
+     ["robot_range.yaml", "laser.range_max", "1000"]),
     # -- maps
     ("map_origin", ["run", "--map", "{d}/map_origin.yaml"], ["map_origin.yaml", "origin", "1e+06"]),
     ("map_dup", ["run", "--map", "{d}/map_dup.yaml"], ["map_dup.yaml", "duplicate key"]),
