@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from pathlib import Path
 from typing import Any, Literal
 
@@ -44,6 +45,9 @@ from arena.core.names import RULE, SafeName
 from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, resolve_world
 from arena.tasks.datafiles import find_data_file, read_yaml_any
+
+MAX_EPISODES = 1_000_000
+"""Most episodes a (scaled) suite may have: weeks of simulation; more is a typo in a scale."""
 
 
 class _Arena(BaseModel):
@@ -114,7 +118,9 @@ class SuiteStage(_Arena):
     """One stage of a suite."""
 
     name: SafeName = Field(description=f"stage name (reports, output folders): {RULE}")
-    episodes: int = Field(ge=0, description="episodes before scale_episodes")
+    episodes: int = Field(
+        ge=0, le=MAX_EPISODES, description="episodes before scale_episodes (<= 1,000,000)"
+    )
     robot: str | None = Field(None, description="robot preset or YAML; None: the run's")
     map: str | dict[str, Any] | None = Field(
         None, description="world name/folder, 'dynamic_map' or a map block; None: the run's"
@@ -236,8 +242,15 @@ class Suite:
     def __init__(
         self, file: SuiteFile, raw: list[dict[str, Any]], source: str, scale_episodes: float = 1.0
     ) -> None:
-        if scale_episodes <= 0:
-            raise ConfigError(f"scale_episodes must be > 0, got {scale_episodes}", source=source)
+        if not (math.isfinite(scale_episodes) and scale_episodes > 0):
+            raise ConfigError(f"scale_episodes must be a finite number > 0, got {scale_episodes}",
+                              source=source)
+        total = sum(st.episodes for st in file.stages) * scale_episodes
+        if total > MAX_EPISODES:
+            raise ConfigError(
+                f"scale_episodes {scale_episodes:g} gives {total:.3g} episodes; a suite has at "
+                f"most {MAX_EPISODES:,}", source=source,
+            )
         self.stages = list(file.stages)
         self.source = source
         self.scale_episodes = float(scale_episodes)
