@@ -91,6 +91,8 @@ FILES: dict[str, str | bytes] = {
     "shelf_goal.json": _scenario(goal=[5.0, 5.3, 0.0],
                                  static=[{"name": "s", "model": "shelf", "pos": [5.0, 5.0, 0.0]}]),
     "nan.json": _scenario(start=[float("nan"), 2.0, 0.0]),
+    "crowd.json": _scenario(peds=[{"name": f"p{i}", "pos": [i % 100, i // 100, 0]}
+                                  for i in range(10_001)]),
     "pos4.json": _scenario(start=[1.0, 2.0, 0.0, 4.0]),
     "waypoint_mode.json": _scenario(ped={"waypoint_mode": 3}),
     "dup_keys.json": '{"robots": [], "robots": []}',
@@ -297,6 +299,7 @@ CASES: list[tuple[str, list[str], list[str]]] = [
         ("shelf", ["robots[0].start", "overlaps obstacle 's' (shelf)"]),
         ("shelf_goal", ["robots[0].goal", "overlaps obstacle 's' (shelf)"]),
         ("nan", ["robots[0].start"]),
+        ("crowd", ["obstacles.dynamic", "at most 10000 items"]),
         ("pos4", ["robots[0].start"]),
         ("waypoint_mode", ["obstacles.dynamic[0].waypoint_mode"]),
         ("dup_keys", ["duplicate key 'robots'"]),

@@ -22,6 +22,11 @@ WAYPOINT_LOOP = 0
 WAYPOINT_RANDOM = 1
 """Arena's ``waypoint_mode`` 1: after each waypoint pick another one at random."""
 
+MAX_COUNT = 10_000
+"""Most obstacles (or people) of one class in an episode: far beyond the dense crowds the 2-D
+simulation is used for (1,000 people), while ``dynamic=1e9`` is refused at once instead of
+allocating gigabytes."""
+
 MAX_PERSON_SPEED = 3.0
 """m/s, the highest walking speed (``vmax``) a task may give a person: a fast run for an adult.
 The crowd models may still scale it (pedsim's running state doubles it); a larger value is a

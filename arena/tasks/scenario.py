@@ -71,6 +71,7 @@ from arena.maps.obstacles import make_obstacle, obstacle_model
 from arena.robots.model import RobotModel
 from arena.sim.state import Obstacle
 from arena.tasks.episode import (
+    MAX_COUNT,
     MAX_PERSON_SPEED,
     WAYPOINT_LOOP,
     AgentSpawn,
@@ -268,9 +269,9 @@ class Obstacles(BaseModel):
 
     model_config = _CONFIG
 
-    static: tuple[ObstacleEntry, ...] = ()
-    interactive: tuple[ObstacleEntry, ...] = ()
-    dynamic: tuple[Pedestrian, ...] = ()
+    static: tuple[ObstacleEntry, ...] = Field((), max_length=MAX_COUNT)
+    interactive: tuple[ObstacleEntry, ...] = Field((), max_length=MAX_COUNT)
+    dynamic: tuple[Pedestrian, ...] = Field((), max_length=MAX_COUNT)
 
 
 class Scenario(BaseModel):

@@ -41,10 +41,9 @@ from arena.core.errors import ConfigError
 from arena.maps.obstacles import obstacle_models
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import AgentSpawn
+from arena.tasks.episode import MAX_COUNT, AgentSpawn
 from arena.tasks.obstacle_modes.random import (
     BOX,
-    MAX_COUNT,
     PlacementParams,
     place_obstacles,
     place_pedestrians,

@@ -27,7 +27,13 @@ from arena.maps.obstacles import make_obstacle, obstacle_models
 from arena.maps.raster import polygon_mask, polygon_window
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import MAX_PERSON_SPEED, WAYPOINT_LOOP, AgentSpawn, speed_range_problem
+from arena.tasks.episode import (
+    MAX_COUNT,
+    MAX_PERSON_SPEED,
+    WAYPOINT_LOOP,
+    AgentSpawn,
+    speed_range_problem,
+)
 from arena.tasks.sampling import (
     MaskRegions,
     clear_near,
@@ -38,11 +44,6 @@ from arena.tasks.sampling import (
 
 BOX = "box"
 """Pseudo-model: a cuboid with random edge lengths."""
-
-MAX_COUNT = 10_000
-"""Most obstacles (or people) of one class in an episode: far beyond the dense crowds the 2-D
-simulation is used for (1,000 people), while ``dynamic=1e9`` is refused at once instead of
-allocating gigabytes."""
 
 
 class Count(BaseModel):
