@@ -53,8 +53,8 @@ class GridSizeParams(BaseModel):
     """
 
     model_config = ConfigDict(frozen=True, extra="forbid")
-    width: float = Field(10.0, gt=0, description="m")
-    height: float = Field(10.0, gt=0, description="m")
+    width: float = Field(10.0, gt=0, description="m (the map: 3 to 50,000,000 cells)")
+    height: float = Field(10.0, gt=0, description="m (the map: 3 to 50,000,000 cells)")
     resolution: float = Field(0.05, gt=0, description="m per cell")
 
     @model_validator(mode="after")
