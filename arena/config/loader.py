@@ -66,20 +66,22 @@ def parse_override(text: str) -> tuple[str, Any]:
     """Split ``"a.b=value"`` into the key path and the YAML-parsed value."""
     if "=" not in text:
         raise ConfigError(
-            f"override {text!r} is not of the form key.path=value", source="command line"
+            f"override {shorten(repr(text))} is not of the form key.path=value",
+            source="command line",
         )
     key, _, raw = text.partition("=")
     key = key.strip()
     if not _KEY.match(key):
         raise ConfigError(
-            f"override {text!r}: {key!r} is not a dotted key path", source="command line"
+            f"override {shorten(repr(text))}: {shorten(repr(key))} is not a dotted key path",
+            source="command line",
         )
     try:
         value = yaml.load(raw, Loader=files.StrictLoader) if raw.strip() else ""
     except (yaml.composer.ComposerError, yaml.constructor.ConstructorError) as e:
         # Well-formed YAML that the strict loader refuses (duplicate key, nesting, alias bomb).
         raise ConfigError(
-            f"override {text!r}: {files.yaml_problem(e)}", source="command line"
+            f"override {shorten(repr(text))}: {files.yaml_problem(e)}", source="command line"
         ) from None
     except yaml.YAMLError:
         value = raw  # not YAML: keep the literal string
@@ -160,7 +162,7 @@ def _apply(data: dict[str, Any], key: str, value: Any, text: str) -> dict[str, A
         ):
             raise ConfigError(
                 f"cannot set {key!r}: {'.'.join(parts[: i + 1])!r} is a value, not a block",
-                source=f"override {text!r}",
+                source=f"override {shorten(repr(text))}",
                 path=key,
             )
         node = node.get(part, {}) if isinstance(node, dict) else {}

@@ -50,6 +50,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -57,8 +58,6 @@ from pydantic import (
     StrictInt,
     StrictStr,
     ValidationError,
-    ValidationInfo,
-    field_validator,
     model_validator,
 )
 
@@ -103,8 +102,47 @@ Position = Annotated[tuple[Num, ...], Field(min_length=2, max_length=3)]
 """``[x, y]`` or ``[x, y, θ]`` (m, rad); a missing θ is 0."""
 Waypoint = Annotated[tuple[Num, ...], Field(min_length=2, max_length=3)]
 """``[x, y]`` or ``[x, y, r]`` (m); Arena forwards ``r`` to pedsim as a radius."""
-Param = Num | Annotated[tuple[Num, Num], Field(description="[lo, hi], sampled")]
-"""A pedsim parameter: a number, or ``[lo, hi]`` sampled from N((lo+hi)/2, (hi−lo)/6) clipped."""
+
+
+def _bounds(v: float | tuple[float, float]) -> tuple[float, float]:
+    return v if isinstance(v, tuple) else (v, v)
+
+
+def _check_param(v: float | tuple[float, float]) -> float | tuple[float, float]:
+    # A reversed [hi, lo] would reach numpy as a negative spread ("scale < 0") only when the
+    # episode is drawn; no pedsim parameter is negative.
+    lo, hi = _bounds(v)
+    if lo > hi:
+        raise ValueError(f"a range must be [low, high], got {[lo, hi]}")
+    if lo < 0:
+        raise ValueError(f"must be >= 0, got {v!r}")
+    return v
+
+
+def _check_probability(v: float | tuple[float, float]) -> float | tuple[float, float]:
+    if _bounds(v)[1] > 1:
+        raise ValueError(f"a probability must lie in [0, 1], got {v!r}")
+    return v
+
+
+def _check_speed(v: float | tuple[float, float]) -> float | tuple[float, float]:
+    if speed_range_problem(*_bounds(v)):  # a vmax of 1e6 m/s is a typo, not a person
+        raise ValueError(
+            f"must lie in [0, {MAX_PERSON_SPEED:g}] m/s (a person's walking speed), got {v!r}"
+        )
+    return v
+
+
+Param = Annotated[
+    Num | Annotated[tuple[Num, Num], Field(description="[lo, hi], sampled")],
+    AfterValidator(_check_param),
+]
+"""A pedsim parameter: a number >= 0, or ``[lo, hi]`` (lo <= hi) sampled from
+N((lo+hi)/2, (hi−lo)/6) clipped."""
+Probability = Annotated[Param, AfterValidator(_check_probability)]
+"""A :data:`Param` in [0, 1]."""
+Speed = Annotated[Param, AfterValidator(_check_speed)]
+"""A :data:`Param` in m/s within [0, :data:`~arena.tasks.episode.MAX_PERSON_SPEED`]."""
 
 
 # NaN or infinity is never a valid coordinate or parameter (Python's json accepts them).
@@ -158,31 +196,6 @@ class ObstacleEntry(BaseModel):
         return out
 
 
-PARAM_FIELDS = (
-    "vmax",
-    "chatting_probability",
-    "tell_story_probability",
-    "group_talking_probability",
-    "talking_and_walking_probability",
-    "requesting_service_probability",
-    "requesting_guide_probability",
-    "requesting_follower_probability",
-    "max_talking_distance",
-    "max_servicing_radius",
-    "talking_base_time",
-    "tell_story_base_time",
-    "group_talking_base_time",
-    "talking_and_walking_base_time",
-    "receiving_service_base_time",
-    "requesting_service_base_time",
-    "force_factor_desired",
-    "force_factor_obstacle",
-    "force_factor_social",
-    "force_factor_robot",
-)
-"""The pedestrian keys that take a number or a ``[lo, hi]`` range (:data:`Param`)."""
-
-
 class Pedestrian(BaseModel):
     """A dynamic obstacle (pedsim pedestrian) with Arena's optional per-ped overrides.
 
@@ -201,17 +214,17 @@ class Pedestrian(BaseModel):
         WAYPOINT_LOOP, ge=0, le=2, description="0 loop, 1 random, 2 undefined (read as loop)"
     )
     id: StrictInt | None = Field(None, description="present in some files; not used")
-    vmax: Param | None = Field(None, description="m/s")
+    vmax: Speed | None = Field(None, description="m/s, 0 to 3")
     start_up_mode: Literal["default", "wait_timer", "trigger_zone"] | None = None
     wait_time: Num | None = Field(None, ge=0, description="s, for start_up_mode wait_timer")
     trigger_zone_radius: Num | None = Field(None, ge=0, description="m, for trigger_zone")
-    chatting_probability: Param | None = None
-    tell_story_probability: Param | None = None
-    group_talking_probability: Param | None = None
-    talking_and_walking_probability: Param | None = None
-    requesting_service_probability: Param | None = None
-    requesting_guide_probability: Param | None = None
-    requesting_follower_probability: Param | None = None
+    chatting_probability: Probability | None = None
+    tell_story_probability: Probability | None = None
+    group_talking_probability: Probability | None = None
+    talking_and_walking_probability: Probability | None = None
+    requesting_service_probability: Probability | None = None
+    requesting_guide_probability: Probability | None = None
+    requesting_follower_probability: Probability | None = None
     max_talking_distance: Param | None = None
     max_servicing_radius: Param | None = None
     talking_base_time: Param | None = None
@@ -224,33 +237,6 @@ class Pedestrian(BaseModel):
     force_factor_obstacle: Param | None = None
     force_factor_social: Param | None = None
     force_factor_robot: Param | None = None
-
-    @field_validator(*PARAM_FIELDS)
-    @classmethod
-    def _plausible(cls, v: Any, info: ValidationInfo) -> Any:
-        """Ranges run low to high, nothing is negative, probabilities are at most 1, speeds human.
-
-        A reversed ``[hi, lo]`` would reach numpy as a negative spread ("scale < 0") only when
-        the episode is drawn; a vmax of 1e6 m/s is a typo, not a person.
-        """
-        if v is None:
-            return v
-        lo, hi = v if isinstance(v, tuple) else (v, v)
-        name = info.field_name or ""
-        if lo > hi:
-            raise ValueError(f"a range must be [low, high], got {list(v)}")
-        if name == "vmax":
-            if not isinstance(v, tuple) and speed_range_problem(lo, hi):
-                raise ValueError(f"must lie in [0, {MAX_PERSON_SPEED:g}] m/s (a person's walking "
-                                 f"speed), got {v!r}")
-            problem = speed_range_problem(lo, hi)
-            if problem:
-                raise ValueError(f"vmax {problem}")
-        elif lo < 0:
-            raise ValueError(f"must be >= 0, got {v!r}")
-        elif name.endswith("_probability") and hi > 1:
-            raise ValueError(f"a probability must lie in [0, 1], got {v!r}")
-        return v
 
     @property
     def kind(self) -> str:
