@@ -269,6 +269,16 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("override_deep", ["run", "name=" + "[" * 100 + "]" * 100],
      ["command line", "nested deeper than 64"]),
     ("override_cycle", ["run", "task=&a {modules: [*a]}"], ["command line", "cycle"]),
+    # -- command-line options (click would draw a multi-line box)
+    ("option_type", ["run", "-n", "abc"], ["'--episodes' / '-n'", "valid integer",
+                                           "(see arena run --help)"]),
+    ("option_unknown", ["run", "--bogus"], ["No such option: --bogus"]),
+    ("command_unknown", ["bogus"], ["No such command 'bogus'"]),
+    ("argument_missing", ["report"], ["Missing argument 'run'"]),
+    ("preview_seed", ["tasks", "preview", "quick", "--seed", "-1"],
+     ["seed", "greater than or equal to 0"]),
+    ("preview_seed_huge", ["tasks", "preview", "quick", "--seed", "99999999999999999999"],
+     ["seed"]),
     # -- experiment config files
     ("config_dup_key", ["run", "{d}/dup.yaml"], ["dup.yaml", "line 3", "duplicate key 'seed'"]),
     ("config_nested_dup", ["run", "{d}/nested_dup.yaml"],
