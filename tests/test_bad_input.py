@@ -59,6 +59,11 @@ FILES: dict[str, str | bytes] = {
     # experiment configs
     "dup.yaml": "seed: 1\nrobot: burger\nseed: 2\n",
     "bomb.yaml": BOMB,
+    # the shape that ran on: the bomb where a string is expected, so that the error message
+    # would print the expanded value
+    "bomb_name.yaml": "name: [" + ", ".join(
+        ["&a0 [x, x, x, x, x, x, x, x, x]"]
+        + [f"&a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 9)]) + "]\n",
     "deep.yaml": "name: " + "[" * 200 + "]" * 200 + "\n",
     "open_brackets.yaml": "[" * 100_000,
     "binary.yaml": bytes(range(256)) * 4,
@@ -284,6 +289,8 @@ CASES: list[tuple[str, list[str], list[str]]] = [
     ("config_nested_dup", ["run", "{d}/nested_dup.yaml"],
      ["nested_dup.yaml", "duplicate key 'timeout'"]),
     ("config_bomb", ["run", "{d}/bomb.yaml"], ["bomb.yaml", "more than 1,000,000 values"]),
+    ("config_bomb_name", ["run", "{d}/bomb_name.yaml"],
+     ["bomb_name.yaml", "more than 1,000,000 values"]),
     ("config_deep", ["run", "{d}/deep.yaml"], ["deep.yaml", "nested deeper than 64"]),
     ("config_open_brackets", ["run", "{d}/open_brackets.yaml"],
      ["open_brackets.yaml", "nested deeper than 64"]),
