@@ -738,14 +738,47 @@ def report(
 
 
 def main() -> None:
-    """Console-script entry point: run the app, print user errors as one line."""
+    """Console-script entry point: run the app, print user errors as one line.
+
+    Command-line mistakes (an unknown option, ``-n abc``) are click usage errors, which click
+    would draw as a multi-line box: they are printed as one line too, naming the option.
+    """
+    from pydantic import ValidationError
+    from rich.markup import escape
+
+    from arena.core.errors import from_validation_error
+
     try:
-        app()
+        code = app(standalone_mode=False, prog_name="arena")
+    except typer.Abort:  # Ctrl-C or end of input at a prompt
+        err_console.print("aborted", highlight=False)
+        sys.exit(130)
+    except typer.TyperException as e:  # typer's (vendored) click errors: usage, bad values
+        ctx = getattr(e, "ctx", None)
+        if type(e).__name__ == "NoArgsIsHelpError" and ctx is not None:
+            console.print(ctx.get_help())  # `arena maps`: the group's help, as click shows it
+            sys.exit(0)
+        if os.environ.get("ARENA_DEBUG"):
+            raise
+        text = e.format_message() if hasattr(e, "format_message") else str(e)
+        hint = f" (see {ctx.command_path} --help)" if ctx is not None else ""
+        err_console.print(f"[bold red]error:[/] {escape(' '.join(text.split()))}{hint}",
+                          highlight=False, soft_wrap=True)
+        sys.exit(int(getattr(e, "exit_code", 2)))
+    except ValidationError as e:  # an option checked by a config model (tasks preview --seed)
+        if os.environ.get("ARENA_DEBUG"):
+            raise
+        err_console.print(f"[bold red]error:[/] {escape(str(from_validation_error(e)))}",
+                          highlight=False, soft_wrap=True)
+        sys.exit(2)
     except ArenaError as e:
         if os.environ.get("ARENA_DEBUG"):
             raise
-        err_console.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
+        # escape: messages hold key paths like [min, max], which are not rich markup
+        err_console.print(f"[bold red]error:[/] {escape(str(e))}", highlight=False,
+                          soft_wrap=True)
         sys.exit(2)
+    sys.exit(code if isinstance(code, int) else 0)
 
 
 if __name__ == "__main__":

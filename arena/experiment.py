@@ -39,6 +39,7 @@ import yaml
 import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ArenaError, PlanningError
+from arena.core.files import make_dir
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
@@ -565,12 +566,7 @@ def run_experiment(
     n_episodes = generator.num_episodes or cfg.episodes
     # Draw the first episode before writing anything: a bad map or task fails with no output.
     first = generator.episode(0)
-    out = Path(out_dir or cfg.output.dir or default_output_dir(cfg))
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:  # a file of that name, /dev/null, a name too long, no permission
-        raise ArenaError(f"{out}: cannot create the output folder (output.dir, -o): "
-                         f"{e.strerror or e}") from None
+    out = make_dir(Path(out_dir or cfg.output.dir or default_output_dir(cfg)))
     (out / "config.yaml").write_text(yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False))
     results: list[EpisodeResult] = []
     for i in range(n_episodes):

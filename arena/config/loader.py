@@ -21,8 +21,9 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
-from arena.config.schema import ExperimentConfig
-from arena.core.errors import ConfigError, UnknownNameError, from_validation_error
+from arena.config.schema import ExperimentConfig, non_finite_key
+from arena.core import files
+from arena.core.errors import ConfigError, UnknownNameError, from_validation_error, shorten
 
 PRESETS_DIR = Path(__file__).resolve().parent / "presets"
 DEFAULT_CONFIG = PRESETS_DIR / "default.yaml"
@@ -30,19 +31,13 @@ _KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
 
 
 def read_yaml(path: str | Path) -> dict[str, Any]:
-    """Read a YAML mapping; missing files and malformed YAML raise :class:`ConfigError`."""
+    """Read a YAML mapping (rules of :mod:`arena.core.files`: duplicate keys, bombs refused).
+
+    Raises:
+        ConfigError: missing or unreadable file, malformed YAML, not a mapping.
+    """
     p = Path(path)
-    if not p.is_file():
-        raise ConfigError("file not found", source=str(p))
-    try:
-        data = yaml.safe_load(p.read_text(encoding="utf-8"))
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
-        raise ConfigError(f"malformed YAML{where}: {problem}", source=str(p)) from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise ConfigError(f"cannot read file: {e}", source=str(p)) from None
+    data = files.read_yaml(p)
     if data is None:
         return {}
     if not isinstance(data, dict):
@@ -71,16 +66,23 @@ def parse_override(text: str) -> tuple[str, Any]:
     """Split ``"a.b=value"`` into the key path and the YAML-parsed value."""
     if "=" not in text:
         raise ConfigError(
-            f"override {text!r} is not of the form key.path=value", source="command line"
+            f"override {shorten(repr(text))} is not of the form key.path=value",
+            source="command line",
         )
     key, _, raw = text.partition("=")
     key = key.strip()
     if not _KEY.match(key):
         raise ConfigError(
-            f"override {text!r}: {key!r} is not a dotted key path", source="command line"
+            f"override {shorten(repr(text))}: {shorten(repr(key))} is not a dotted key path",
+            source="command line",
         )
     try:
-        value = yaml.safe_load(raw) if raw.strip() else ""
+        value = yaml.load(raw, Loader=files.StrictLoader) if raw.strip() else ""
+    except (yaml.composer.ComposerError, yaml.constructor.ConstructorError) as e:
+        # Well-formed YAML that the strict loader refuses (duplicate key, nesting, alias bomb).
+        raise ConfigError(
+            f"override {shorten(repr(text))}: {files.yaml_problem(e)}", source="command line"
+        ) from None
     except yaml.YAMLError:
         value = raw  # not YAML: keep the literal string
     return key, value
@@ -123,13 +125,19 @@ def load_config(path: str | Path | None = None, overrides: Sequence[str] = ()) -
             )
             if (
                 err.path == key
-                or err.path.startswith(key + ".")
+                or err.path.startswith((key + ".", key + "["))
                 or key.startswith(err.path + ".")
                 or same_block
             ):
-                return type(err)(err.message, source=f"override {text!r}", path=err.path)
+                return type(err)(
+                    err.message, source=f"override {shorten(repr(text))}", path=err.path
+                )
         return err
 
+    found = non_finite_key(data)
+    if found is not None:
+        raise located(ConfigError(f"must be a finite number, got {found[1]}", source=source,
+                                  path=found[0]))
     try:
         cfg = ExperimentConfig.model_validate(data)
     except ValidationError as e:
@@ -154,7 +162,7 @@ def _apply(data: dict[str, Any], key: str, value: Any, text: str) -> dict[str, A
         ):
             raise ConfigError(
                 f"cannot set {key!r}: {'.'.join(parts[: i + 1])!r} is a value, not a block",
-                source=f"override {text!r}",
+                source=f"override {shorten(repr(text))}",
                 path=key,
             )
         node = node.get(part, {}) if isinstance(node, dict) else {}

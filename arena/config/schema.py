@@ -8,15 +8,37 @@ error names the file and the key path.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, model_validator
 
+from arena.core.names import RULE, SafeLabel
+from arena.core.rng import Seed
 from arena.crowd.simulator import PedestrianConfig
 from arena.learn.config import LearningConfig
 from arena.nav.stack import NavigationConfig
 from arena.tasks.config import TaskConfig
+
+
+def non_finite_key(data: Any) -> tuple[str, float] | None:
+    """The key path and value of the first infinite or NaN number in a config (``None``: none).
+
+    No setting of an experiment means "unbounded" by infinity (``task.timeout: .inf`` would run
+    an episode forever), and NaN compares false with every bound, so configs hold finite numbers
+    only. Checked on the raw data, so that plugin blocks (plain mappings here) are covered too.
+    """
+    stack: list[tuple[str, Any]] = [("", data)]
+    while stack:
+        path, value = stack.pop()
+        if isinstance(value, float) and not math.isfinite(value):
+            return path, value
+        if isinstance(value, dict):
+            stack.extend((f"{path}.{k}" if path else str(k), v) for k, v in value.items())
+        elif isinstance(value, list | tuple):
+            stack.extend((f"{path}[{i}]", v) for i, v in enumerate(value))
+    return None
 
 
 class _Strict(BaseModel):
@@ -56,9 +78,15 @@ class EvaluationConfig(_Strict):
 class ExperimentConfig(_Strict):
     """One experiment: a robot, a map, a task, a crowd, a navigation stack, a simulator."""
 
-    name: str = Field("default", description="label for outputs")
-    seed: int = Field(0, ge=0, description="master seed: every random draw derives from it")
-    episodes: int = Field(1, ge=1, description="number of episodes")
+    name: SafeLabel = Field(
+        "default",
+        description=f"label for outputs, part of the run folder's name: {RULE} "
+        "('/' separates sub-folders)",
+    )
+    seed: Seed = Field(
+        0, description="master seed: every random draw derives from it; an int in [0, 2**63)"
+    )
+    episodes: StrictInt = Field(1, ge=1, description="number of episodes")
     robot: str = Field("jackal", description="robot preset name or path to a robot YAML")
     map: dict[str, Any] = Field(
         default_factory=lambda: {"type": "world", "name": "small_office"},
@@ -76,3 +104,11 @@ class ExperimentConfig(_Strict):
     learning: LearningConfig = Field(
         default_factory=LearningConfig, description="RL environments (arena.learn)"
     )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _finite(cls, data: Any) -> Any:
+        found = non_finite_key(data)
+        if found is not None:
+            raise ValueError(f"{found[0]}: must be a finite number, got {found[1]}")
+        return data

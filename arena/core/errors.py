@@ -81,6 +81,11 @@ class SimulationError(ArenaError):
     """The simulator was used wrongly (e.g. step before reset, wrong command shape)."""
 
 
+def shorten(text: str, limit: int = 80) -> str:
+    """``text`` cut to about ``limit`` characters (a 300-character value stays readable)."""
+    return text if len(text) <= limit else f"{text[: limit - 20]}... ({len(text)} characters)"
+
+
 def format_loc(loc: Iterable[Any]) -> str:
     """Turn a pydantic error location tuple into a dotted path: ``('a', 0, 'b')`` → ``a[0].b``."""
     out = ""
@@ -108,8 +113,10 @@ def from_validation_error(
             text = "unknown key (not a field of this block; check the spelling)"
         elif e["type"] == "missing":
             text = "required key is missing"
+        elif e["type"] == "value_error" and "error" in e.get("ctx", {}):
+            text = str(e["ctx"]["error"])  # our own validators' messages say what they got
         else:
-            text = f"{e['msg']} (got {e.get('input')!r})"
+            text = f"{e['msg']} (got {shorten(repr(e.get('input')))})"
         msgs.append((loc, text))
 
     def full(loc: str) -> str:

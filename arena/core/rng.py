@@ -8,10 +8,22 @@ Names are hashed with CRC32 (stable across runs, unlike Python's ``hash``).
 from __future__ import annotations
 
 import zlib
+from typing import Annotated
 
 import numpy as np
+from pydantic import Field, StrictInt
 
 Key = str | int
+
+MAX_SEED = 2**63 - 1
+"""Largest seed a config accepts: seeds are non-negative ints that fit an int64 (the libraries
+that take integer seeds, and the stores that keep them, want 64-bit integers)."""
+
+Seed = Annotated[
+    StrictInt,
+    Field(ge=0, le=MAX_SEED, description="a non-negative integer <= 2**63 - 1 (not a bool)"),
+]
+"""A pydantic field type for seeds: ``true`` or ``"3"`` is not a seed, nor is ``-1``."""
 
 
 def _key_to_int(key: Key) -> int:

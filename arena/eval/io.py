@@ -32,6 +32,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from numpy.typing import NDArray
 
+from arena.core.errors import ConfigError
 from arena.eval.record import EpisodeMeta, EpisodeRecord
 
 FORMAT = "episode-record/1"
@@ -187,8 +188,17 @@ def save_record(record: EpisodeRecord, path: str | Path) -> Path:
 
 
 def load_record(path: str | Path) -> EpisodeRecord:
-    """Read a file written by :func:`save_record`."""
-    return table_to_record(pq.read_table(Path(path)))
+    """Read a file written by :func:`save_record`.
+
+    Raises:
+        ConfigError: the file is not such a record (corrupt, truncated, another table), naming
+            the file: a record comes from a run folder, which may be damaged or foreign.
+    """
+    try:
+        return table_to_record(pq.read_table(Path(path)))
+    except (pa.ArrowException, OSError, ValueError, KeyError, TypeError, IndexError) as e:
+        reason = str(e).splitlines()[0] if str(e) else type(e).__name__
+        raise ConfigError(f"not a readable episode record ({reason})", source=str(path)) from None
 
 
 # ---------------------------------------------------------------------------------------------

@@ -132,8 +132,9 @@ def write_tables(table: Any, out: str | Path) -> tuple[Path, Path]:
     Returns:
         The CSV and LaTeX paths.
     """
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    from arena.core.files import make_dir
+
+    out = make_dir(out, what="report folder")
     rows = summary_table(table)
     csv_path, tex_path = out / "summary.csv", out / "summary.tex"
     with csv_path.open("w", newline="") as f:

@@ -37,6 +37,7 @@ from pydantic import (
 
 from arena import __version__
 from arena.core.errors import ArenaError, ConfigError, from_validation_error
+from arena.core.names import check_name
 from arena.eval.io import save_record
 from arena.eval.record import EpisodeRecord
 
@@ -91,15 +92,14 @@ def _write_json(path: Path, data: Any) -> None:
     _atomic_write(path, write)
 
 
-def _check_name(name: str, what: str) -> None:
-    if not name or name in (".", "..") or "/" in name or "\\" in name or "\0" in name:
-        raise ArenaError(f"{what} name {name!r} cannot be a folder name")
-
-
 def episode_stem(run: Path, contestant: str, stage: str, episode: int) -> Path:
-    """``<run>/episodes/<contestant>/<stage>/<episode:04d>`` (no suffix)."""
-    _check_name(contestant, "contestant")
-    _check_name(stage, "stage")
+    """``<run>/episodes/<contestant>/<stage>/<episode:04d>`` (no suffix).
+
+    Raises:
+        ConfigError: a name that cannot be a folder name (:func:`arena.core.names.check_name`).
+    """
+    check_name(contestant, "contestant name")
+    check_name(stage, "stage name")
     return Path(run) / EPISODES / contestant / stage / f"{int(episode):04d}"
 
 
@@ -223,11 +223,13 @@ def completed(run: str | Path) -> set[tuple[str, str, int]]:
     return out
 
 
-def _check_row(path: Path, row: Any) -> dict[str, Any]:
+def _check_row(run: Path, path: Path, row: Any) -> dict[str, Any]:
     """``row`` if it is a metrics row as :func:`commit_episode` writes it, else a one-line error.
 
     Every fixed column must have its type (``seed`` may be null) and every other value must be a
-    number or null; ``contestant``, ``stage`` and ``episode`` must match the file's place.
+    number or null; ``contestant``, ``stage`` and ``episode`` must match the file's place. Its
+    names become paths in reports: a tampered or foreign run folder must not name ``../../X``,
+    so they must be safe names, and ``record`` the parquet file beside the row.
     """
     redo = "; delete the file to run that episode again (--resume)"
     if not isinstance(row, dict):
@@ -251,10 +253,16 @@ def _check_row(path: Path, row: Any) -> dict[str, Any]:
         ):
             raise ArenaError(f"{path}: metric {name!r}: expected a number or null, "
                              f"got {value!r}{redo}")
+    for key in ("contestant", "stage"):
+        check_name(row[key], f"{key} name", source=str(path), path=key)
     place = (path.parent.parent.name, path.parent.name, path.stem)
     if (row["contestant"], row["stage"], f"{row['episode']:04d}") != place:
         raise ArenaError(f"{path}: the row is of {row['contestant']}/{row['stage']}/"
                          f"{row['episode']}, not of the episode its file name says{redo}")
+    record = row.get("record") or ""
+    if record and record != path.with_suffix(".parquet").relative_to(run).as_posix():
+        raise ConfigError(f"{record!r} is not this episode's record file", source=str(path),
+                          path="record")
     return row
 
 
@@ -271,7 +279,7 @@ def load_rows(run: str | Path) -> list[dict[str, Any]]:
         except (OSError, ValueError, RecursionError) as e:
             raise ArenaError(f"{p}: unreadable episode row ({e}); delete the file to run that "
                              f"episode again (--resume)") from None
-        rows.append(_check_row(p, data))
+        rows.append(_check_row(Path(run), p, data))
     rows.sort(key=lambda r: (str(r["contestant"]), str(r["stage"]), int(r["episode"])))
     return rows
 

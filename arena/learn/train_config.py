@@ -37,6 +37,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from arena.core.rng import Seed
+
 
 class _Strict(BaseModel):
     model_config = ConfigDict(frozen=True, extra="forbid")
@@ -200,7 +202,7 @@ class TrainConfig(_Strict):
         description="batched: episodes per world drawn ahead by a helper process, overlapping "
         "the simulation (same episodes either way); 0: drawn in the training process",
     )
-    seed: int | None = Field(None, ge=0, description="run seed; null: the experiment's seed")
+    seed: Seed | None = Field(None, description="run seed; null: the experiment's seed")
     checkpoint_every: int = Field(100_000, ge=1, description="env steps between checkpoints")
     tensorboard: bool = Field(True, description="write TensorBoard logs to RUN/tb")
     device: Literal["auto", "cpu", "cuda"] = Field("cpu", description="torch device")

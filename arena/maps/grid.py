@@ -23,6 +23,41 @@ FREE = 0
 OCCUPIED = 100
 UNKNOWN = -1
 
+MAX_CELLS = 50_000_000
+"""Most cells a map may have (e.g. 350 × 350 m at 5 cm): the grid and its distance map take
+about 9 bytes a cell (450 MB here), and larger requests are mistakes (``map.width=1e9``)."""
+MIN_CELLS = 3
+"""Fewest cells per side: a walled map needs a free cell inside its one-cell border."""
+MAX_COORDINATE = 1e6
+"""m; largest map origin coordinate accepted. Beyond ~1e7 m a float64 cannot tell 5 cm
+cells apart any more (1e20 + 0.05 == 1e20); 1000 km covers any building's map frame."""
+
+
+def check_grid_size(width_m: float, height_m: float, resolution: float) -> tuple[int, int]:
+    """The ``(rows, cols)`` of a ``width_m × height_m`` map at ``resolution`` (m).
+
+    Raises:
+        MapError: a size is not a finite positive number, a side has fewer than
+            :data:`MIN_CELLS` cells or the map more than :data:`MAX_CELLS` cells (with the
+            memory it would take).
+    """
+    for label, v in (("width", width_m), ("height", height_m), ("resolution", resolution)):
+        if not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
+            raise MapError(f"{label} must be a finite number > 0 (m), got {v!r}")
+    rows, cols = round(height_m / resolution), round(width_m / resolution)
+    if min(rows, cols) < MIN_CELLS:
+        raise MapError(
+            f"a {width_m:g} × {height_m:g} m map at resolution {resolution:g} m has "
+            f"{cols} × {rows} cells; each side needs at least {MIN_CELLS} (lower the resolution)"
+        )
+    if rows * cols > MAX_CELLS:
+        raise MapError(
+            f"a {width_m:g} × {height_m:g} m map at resolution {resolution:g} m has "
+            f"{rows * cols:.3g} cells (~{9 * rows * cols / 2**30:.3g} GiB); at most "
+            f"{MAX_CELLS:,} cells are allowed (a smaller map or a coarser resolution)"
+        )
+    return rows, cols
+
 
 @dataclass(frozen=True, eq=False)
 class OccupancyGrid:
@@ -58,6 +93,12 @@ class OccupancyGrid:
             )
         if len(self.origin) != 2 or not np.all(np.isfinite(self.origin)):
             raise MapError(f"origin must be two finite coordinates (m), got {self.origin!r}")
+        if max(abs(float(v)) for v in self.origin) > MAX_COORDINATE:
+            raise MapError(
+                f"origin coordinates must lie within ±{MAX_COORDINATE:g} m, got {self.origin!r}"
+            )
+        if raw.size > MAX_CELLS:
+            raise MapError(f"a map has at most {MAX_CELLS:,} cells, got {raw.shape}")
         # Own copy: freezing the caller's array in place would make *their* array read-only.
         data = np.array(raw, dtype=np.int8, order="C", copy=True)
         data.setflags(write=False)
@@ -84,9 +125,12 @@ class OccupancyGrid:
         walls: bool = True,
         origin: tuple[float, float] = (0.0, 0.0),
     ) -> OccupancyGrid:
-        """Build a free ``width_m × height_m`` (m) map, with a one-cell wall border if asked."""
-        w = round(width_m / resolution)
-        h = round(height_m / resolution)
+        """Build a free ``width_m × height_m`` (m) map, with a one-cell wall border if asked.
+
+        Raises:
+            MapError: see :func:`check_grid_size`.
+        """
+        h, w = check_grid_size(width_m, height_m, resolution)
         occ = np.zeros((h, w), dtype=bool)
         if walls:
             occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True

@@ -55,8 +55,9 @@ from pydantic import (
     field_validator,
 )
 
+from arena.core import files
 from arena.core.errors import ConfigError, format_loc
-from arena.maps.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
+from arena.maps.grid import FREE, MAX_CELLS, MAX_COORDINATE, OCCUPIED, UNKNOWN, OccupancyGrid
 
 __all__ = [
     "SCALED_OCCUPIED",
@@ -126,6 +127,11 @@ class MapMetadata(BaseModel):
                 f"rotated maps are not supported: the origin yaw must be 0 rad, got {v[2]!r} "
                 "(ROS map_server mostly ignores it as well); rotate the image instead"
             )
+        if max(abs(v[0]), abs(v[1])) > MAX_COORDINATE:
+            raise ValueError(
+                f"origin x and y must lie within ±{MAX_COORDINATE:g} m, got {v[:2]!r} (float64 "
+                "positions that far out cannot resolve map cells)"
+            )
         return (v[0], v[1], 0.0)
 
     @field_validator("free_thresh")
@@ -176,18 +182,7 @@ def load_map_with_metadata(
 
 def _read_yaml(yaml_path: Path) -> dict[str, Any]:
     source = str(yaml_path)
-    if not yaml_path.exists():
-        raise ConfigError("map file not found", source=source)
-    if not yaml_path.is_file():
-        raise ConfigError("expected a map.yaml file, found a folder", source=source)
-    try:
-        text = yaml_path.read_bytes()
-    except OSError as e:
-        raise ConfigError(f"cannot read the map file: {e.strerror or e}", source=source) from None
-    try:
-        doc = yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        raise ConfigError(_yaml_problem(e), source=source) from None
+    doc = files.read_yaml(yaml_path, what="map file")
     if doc is None:
         raise ConfigError(
             "the map file is empty; expected keys image, resolution, origin, ...", source=source
@@ -199,15 +194,6 @@ def _read_yaml(yaml_path: Path) -> dict[str, Any]:
             source=source,
         )
     return doc
-
-
-def _yaml_problem(e: yaml.YAMLError) -> str:
-    """One line from a PyYAML error: the problem and its 1-based line and column."""
-    mark = getattr(e, "problem_mark", None) or getattr(e, "context_mark", None)
-    problem = getattr(e, "problem", None) or str(e).splitlines()[0]
-    if mark is not None:
-        return f"invalid YAML at line {mark.line + 1}, column {mark.column + 1}: {problem}"
-    return f"invalid YAML: {problem}"
 
 
 def _parse_metadata(doc: dict[Any, Any], source: str) -> MapMetadata:
@@ -252,6 +238,9 @@ def _read_image(image_path: Path, source: str) -> tuple[NDArray[np.uint8], bool]
         )
     try:
         with Image.open(image_path) as im:
+            if im.size[0] * im.size[1] > MAX_CELLS:
+                raise ValueError(f"{im.size[0]} × {im.size[1]} pixels; a map has at most "
+                                 f"{MAX_CELLS:,} cells")
             im.load()
             return _channels(im)
     # Pillow raises OSError, ValueError, SyntaxError, struct.error, DecompressionBombError ...
@@ -373,7 +362,7 @@ def save_map(
     pixels = np.full(grid.data.shape, _SAVE_UNKNOWN, dtype=np.uint8)
     pixels[grid.data == FREE] = _SAVE_FREE
     pixels[grid.data == OCCUPIED] = _SAVE_OCCUPIED
-    yaml_path.parent.mkdir(parents=True, exist_ok=True)
+    files.make_dir(yaml_path.parent, what="map folder")
     Image.fromarray(np.flipud(pixels), mode="L").save(
         yaml_path.parent / name, format=_FORMATS[image_format]
     )

@@ -12,11 +12,11 @@ from pathlib import Path
 from typing import Protocol
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
-from arena.core.errors import ConfigError
+from arena.core.errors import ConfigError, MapError
 from arena.core.registry import Registry
-from arena.maps.grid import OccupancyGrid
+from arena.maps.grid import OccupancyGrid, check_grid_size
 from arena.maps.io import load_map
 from arena.sim.state import Obstacle
 
@@ -42,6 +42,28 @@ class MapSource(Protocol):
 
 
 MAP_SOURCES: Registry[MapSource] = Registry("map source", entry_points="arena.map_sources")
+
+
+class GridSizeParams(BaseModel):
+    """Base of the parameters of generated maps: ``width``, ``height``, ``resolution`` (m).
+
+    The validator refuses sizes the grid cannot hold (infinite, under 3 cells a side, over
+    :data:`~arena.maps.grid.MAX_CELLS` cells) when the config is loaded, so that the error names
+    the key instead of failing while the map is built.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    width: float = Field(10.0, gt=0, description="m (the map: 3 to 50,000,000 cells)")
+    height: float = Field(10.0, gt=0, description="m (the map: 3 to 50,000,000 cells)")
+    resolution: float = Field(0.05, gt=0, description="m per cell")
+
+    @model_validator(mode="after")
+    def _grid_size(self) -> GridSizeParams:
+        try:
+            check_grid_size(self.width, self.height, self.resolution)
+        except MapError as e:
+            raise ValueError(str(e)) from None
+        return self
 
 
 def packaged_worlds() -> list[str]:
@@ -131,6 +153,15 @@ class WorldMap:
         model_config = ConfigDict(frozen=True, extra="forbid")
         name: str = Field(description="packaged world name or path to a world folder")
 
+        @field_validator("name")
+        @classmethod
+        def _exists(cls, v: str) -> str:
+            try:  # when the config is loaded, so that the error names map.name
+                resolve_world(v)
+            except ConfigError as e:
+                raise ValueError(e.message) from None
+            return v
+
     def __init__(self, params: Params) -> None:
         self.params = params
         self._result: MapResult | None = None
@@ -170,13 +201,8 @@ class FileMap:
 class EmptyMap:
     """An empty rectangular room with walls around it."""
 
-    class Params(BaseModel):
-        """Parameters of :class:`EmptyMap`."""
-
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        width: float = Field(10.0, gt=0, description="m")
-        height: float = Field(10.0, gt=0, description="m")
-        resolution: float = Field(0.05, gt=0, description="m per cell")
+    class Params(GridSizeParams):
+        """Parameters of :class:`EmptyMap` (sizes checked by :class:`GridSizeParams`)."""
 
     def __init__(self, params: Params) -> None:
         self.params = params
@@ -200,10 +226,11 @@ def write_world(
     """
     import json
 
+    from arena.core.files import make_dir
     from arena.maps.io import save_map
     from arena.maps.raster import burn_obstacles as burn
 
-    folder = Path(folder)
+    folder = make_dir(folder, what="world folder")
     grid = burn(result.grid, result.obstacles) if burn_obstacles else result.grid
     yaml_path = save_map(grid, folder / "map" / "map.yaml", image_format="png")
     static = [

@@ -46,6 +46,10 @@ _AGENT_CIRCLE_SIDES = 24
 _SCALE_STEPS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0)
 
 
+MAX_WIDTH_PX = 8000
+"""Widest frame drawn (pixels): an 8K image; wider ones take gigabytes for nothing."""
+
+
 @dataclass(frozen=True)
 class Overlay:
     """Planner and task information drawn on top of a state (all optional).
@@ -105,8 +109,10 @@ class FrameRenderer:
         trail_length: int = 600,
         legend: bool = False,
     ) -> None:
-        if width_px < 16:
-            raise ConfigError(f"width_px must be at least 16 pixels, got {width_px}")
+        if not 16 <= width_px <= MAX_WIDTH_PX:
+            raise ConfigError(
+                f"width_px must lie in [16, {MAX_WIDTH_PX}] pixels, got {width_px}"
+            )
         if margin_m < 0:
             raise ConfigError(f"margin_m must be >= 0 m, got {margin_m}")
         self.world = world

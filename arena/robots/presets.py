@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import ValidationError
 
+from arena.core import files
 from arena.core.errors import ConfigError, from_validation_error
 from arena.core.registry import Registry
 from arena.robots.model import CircleFootprint, RobotModel
@@ -57,45 +57,14 @@ for _path in sorted(PRESET_DIR.glob("*.yaml")):
 
 
 # -- loading ------------------------------------------------------------------------------------
-class _StrictLoader(yaml.SafeLoader):
-    """A safe YAML loader that rejects duplicate keys (PyYAML silently keeps the last one)."""
-
-
-def _mapping_no_duplicates(loader: _StrictLoader, node: yaml.MappingNode) -> dict[Any, Any]:
-    seen: dict[Any, Any] = {}
-    for key_node, value_node in node.value:
-        key = loader.construct_object(key_node, deep=True)
-        if key in seen:
-            mark = key_node.start_mark
-            raise yaml.constructor.ConstructorError(
-                None, None, f"duplicate key {key!r}", mark
-            )
-        seen[key] = loader.construct_object(value_node, deep=True)
-    return seen
-
-
-_StrictLoader.add_constructor(
-    yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _mapping_no_duplicates
-)
-
-
 def read_yaml(path: str | Path) -> Any:
-    """Parse a YAML file; errors name the file, the line and the column.
+    """Parse a YAML file with the shared strict loader (:mod:`arena.core.files`).
 
     Raises:
-        ConfigError: the file is missing or is not valid YAML.
+        ConfigError: the file is missing, not UTF-8 text or not valid YAML (duplicate keys
+            included), naming the file, the line and the column.
     """
-    p = Path(path)
-    if not p.is_file():
-        raise ConfigError("file not found", source=str(p))
-    text = p.read_text(encoding="utf-8")
-    try:
-        return yaml.load(text, Loader=_StrictLoader)  # a SafeLoader: no arbitrary objects
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        problem = getattr(e, "problem", None) or str(e)
-        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""
-        raise ConfigError(f"malformed YAML at {where}{problem}", source=str(p)) from None
+    return files.read_yaml(path)
 
 
 def load_robot_file(path: str | Path) -> RobotModel:

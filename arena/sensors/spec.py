@@ -22,10 +22,14 @@ class LidarSpec(BaseModel):
 
     angle_min: float = Field(description="rad, first beam angle in the sensor frame")
     angle_max: float = Field(description="rad, last beam angle in the sensor frame")
-    num_beams: int = Field(gt=0, description="number of beams")
-    range_max: float = Field(gt=0, description="m, beams that hit nothing report this range")
+    num_beams: int = Field(
+        gt=0, le=10_000, description="number of beams (real 2-D scanners: up to a few thousand)"
+    )
+    range_max: float = Field(
+        gt=0, le=1000.0, description="m, beams that hit nothing report this range (<= 1000)"
+    )
     range_min: float = Field(0.0, ge=0, description="m, returns closer than this report range_min")
-    update_rate: float = Field(10.0, gt=0, description="Hz")
+    update_rate: float = Field(10.0, gt=0, le=1000.0, description="Hz (<= 1000)")
     noise_std: float = Field(0.0, ge=0, description="m, std of additive Gaussian range noise")
     mount: tuple[float, float, float] = Field(
         (0.0, 0.0, 0.0), description="sensor pose [x m, y m, yaw rad] in the robot base frame"

@@ -11,8 +11,7 @@ import difflib
 from pathlib import Path
 from typing import Any, Literal
 
-import yaml
-
+from arena.core import files
 from arena.core.errors import ConfigError
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
@@ -52,17 +51,4 @@ def find_data_file(kind: Kind, name_or_path: str | Path) -> Path:
 
 def read_yaml_any(path: str | Path) -> Any:
     """Parse a YAML file of any shape; malformed YAML names the file, line and column."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ConfigError("file not found", source=str(p)) from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise ConfigError(f"cannot read file: {e}", source=str(p)) from None
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""
-        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
-        raise ConfigError(f"malformed YAML{where}: {problem}", source=str(p)) from None
+    return files.read_yaml(path)

@@ -22,6 +22,24 @@ WAYPOINT_LOOP = 0
 WAYPOINT_RANDOM = 1
 """Arena's ``waypoint_mode`` 1: after each waypoint pick another one at random."""
 
+MAX_COUNT = 10_000
+"""Most obstacles (or people) of one class in an episode: far beyond the dense crowds the 2-D
+simulation is used for (1,000 people), while ``dynamic=1e9`` is refused at once instead of
+allocating gigabytes."""
+
+MAX_PERSON_SPEED = 3.0
+"""m/s, the highest walking speed (``vmax``) a task may give a person: a fast run for an adult.
+The crowd models may still scale it (pedsim's running state doubles it); a larger value is a
+typo (``agent_speed=[1000, 2000]``), not a person."""
+
+
+def speed_range_problem(lo: float, hi: float) -> str | None:
+    """Why ``[lo, hi]`` (m/s) is not a range of person speeds, or ``None`` if it is one."""
+    if not 0 <= lo <= hi <= MAX_PERSON_SPEED:
+        return (f"must be [min, max] m/s with 0 <= min <= max <= {MAX_PERSON_SPEED:g} "
+                f"(a person's walking speed), got {[lo, hi]}")
+    return None
+
 
 @dataclass(frozen=True, eq=False)
 class RobotSpawn:

@@ -32,6 +32,13 @@ instead of an error, so that every file Arena ships loads unchanged:
 * A pedestrian with no waypoints stands at its start position.
 * Legacy model names ending in ``.yaml`` (``shelf.yaml``) name the library model ``shelf``.
 * An unknown pedestrian ``type`` is treated as adult (what Arena's crowd model does).
+
+Refused although Arena would load them (no published file has them; each would fail late or
+make no sense): a key given twice, a ``[hi, lo]`` range, a negative parameter, a probability
+above 1, a ``vmax`` outside [0, 3] m/s, a robot goal within the goal radius of its start, two
+pedestrians overlapping at their starts. Against the episode's map the task modes also refuse a
+robot whose real footprint overlaps a wall or an obstacle at its start or goal (``check_map:
+false`` turns the map checks off). Both are in :mod:`arena.tasks.scenario_checks`.
 """
 
 from __future__ import annotations
@@ -43,6 +50,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     BaseModel,
     ConfigDict,
     Field,
@@ -53,6 +61,7 @@ from pydantic import (
     model_validator,
 )
 
+from arena.core import files
 from arena.core.errors import ConfigError, UnknownNameError, from_validation_error
 from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
@@ -61,10 +70,13 @@ from arena.maps.obstacles import make_obstacle, obstacle_model
 from arena.robots.model import RobotModel
 from arena.sim.state import Obstacle
 from arena.tasks.episode import (
+    MAX_COUNT,
+    MAX_PERSON_SPEED,
     WAYPOINT_LOOP,
     AgentSpawn,
     Episode,
     RobotSpawn,
+    speed_range_problem,
 )
 
 DEFAULT_VMAX = 0.3
@@ -90,8 +102,47 @@ Position = Annotated[tuple[Num, ...], Field(min_length=2, max_length=3)]
 """``[x, y]`` or ``[x, y, θ]`` (m, rad); a missing θ is 0."""
 Waypoint = Annotated[tuple[Num, ...], Field(min_length=2, max_length=3)]
 """``[x, y]`` or ``[x, y, r]`` (m); Arena forwards ``r`` to pedsim as a radius."""
-Param = Num | Annotated[tuple[Num, Num], Field(description="[lo, hi], sampled")]
-"""A pedsim parameter: a number, or ``[lo, hi]`` sampled from N((lo+hi)/2, (hi−lo)/6) clipped."""
+
+
+def _bounds(v: float | tuple[float, float]) -> tuple[float, float]:
+    return v if isinstance(v, tuple) else (v, v)
+
+
+def _check_param(v: float | tuple[float, float]) -> float | tuple[float, float]:
+    # A reversed [hi, lo] would reach numpy as a negative spread ("scale < 0") only when the
+    # episode is drawn; no pedsim parameter is negative.
+    lo, hi = _bounds(v)
+    if lo > hi:
+        raise ValueError(f"a range must be [low, high], got {[lo, hi]}")
+    if lo < 0:
+        raise ValueError(f"must be >= 0, got {v!r}")
+    return v
+
+
+def _check_probability(v: float | tuple[float, float]) -> float | tuple[float, float]:
+    if _bounds(v)[1] > 1:
+        raise ValueError(f"a probability must lie in [0, 1], got {v!r}")
+    return v
+
+
+def _check_speed(v: float | tuple[float, float]) -> float | tuple[float, float]:
+    if speed_range_problem(*_bounds(v)):  # a vmax of 1e6 m/s is a typo, not a person
+        raise ValueError(
+            f"must lie in [0, {MAX_PERSON_SPEED:g}] m/s (a person's walking speed), got {v!r}"
+        )
+    return v
+
+
+Param = Annotated[
+    Num | Annotated[tuple[Num, Num], Field(description="[lo, hi], sampled")],
+    AfterValidator(_check_param),
+]
+"""A pedsim parameter: a number >= 0, or ``[lo, hi]`` (lo <= hi) sampled from
+N((lo+hi)/2, (hi−lo)/6) clipped."""
+Probability = Annotated[Param, AfterValidator(_check_probability)]
+"""A :data:`Param` in [0, 1]."""
+Speed = Annotated[Param, AfterValidator(_check_speed)]
+"""A :data:`Param` in m/s within [0, :data:`~arena.tasks.episode.MAX_PERSON_SPEED`]."""
 
 
 # NaN or infinity is never a valid coordinate or parameter (Python's json accepts them).
@@ -163,17 +214,17 @@ class Pedestrian(BaseModel):
         WAYPOINT_LOOP, ge=0, le=2, description="0 loop, 1 random, 2 undefined (read as loop)"
     )
     id: StrictInt | None = Field(None, description="present in some files; not used")
-    vmax: Param | None = Field(None, description="m/s")
+    vmax: Speed | None = Field(None, description="m/s, 0 to 3")
     start_up_mode: Literal["default", "wait_timer", "trigger_zone"] | None = None
     wait_time: Num | None = Field(None, ge=0, description="s, for start_up_mode wait_timer")
     trigger_zone_radius: Num | None = Field(None, ge=0, description="m, for trigger_zone")
-    chatting_probability: Param | None = None
-    tell_story_probability: Param | None = None
-    group_talking_probability: Param | None = None
-    talking_and_walking_probability: Param | None = None
-    requesting_service_probability: Param | None = None
-    requesting_guide_probability: Param | None = None
-    requesting_follower_probability: Param | None = None
+    chatting_probability: Probability | None = None
+    tell_story_probability: Probability | None = None
+    group_talking_probability: Probability | None = None
+    talking_and_walking_probability: Probability | None = None
+    requesting_service_probability: Probability | None = None
+    requesting_guide_probability: Probability | None = None
+    requesting_follower_probability: Probability | None = None
     max_talking_distance: Param | None = None
     max_servicing_radius: Param | None = None
     talking_base_time: Param | None = None
@@ -204,9 +255,9 @@ class Obstacles(BaseModel):
 
     model_config = _CONFIG
 
-    static: tuple[ObstacleEntry, ...] = ()
-    interactive: tuple[ObstacleEntry, ...] = ()
-    dynamic: tuple[Pedestrian, ...] = ()
+    static: tuple[ObstacleEntry, ...] = Field((), max_length=MAX_COUNT)
+    interactive: tuple[ObstacleEntry, ...] = Field((), max_length=MAX_COUNT)
+    dynamic: tuple[Pedestrian, ...] = Field((), max_length=MAX_COUNT)
 
 
 class Scenario(BaseModel):
@@ -268,16 +319,14 @@ def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
         source: the file name used in error messages.
 
     Raises:
-        ConfigError: malformed JSON (with line and column), a wrong type or unknown key (with
-            the key path, e.g. ``obstacles.dynamic[3].waypoints``), or an obstacle model that is
-            not in the library (with the closest name).
+        ConfigError: malformed JSON (with line and column; duplicate keys and deep nesting
+            included, see :func:`arena.core.files.parse_json`), a wrong type or unknown key
+            (with the key path, e.g. ``obstacles.dynamic[3].waypoints``), an obstacle model
+            that is not in the library (with the closest name), a robot whose start is its goal
+            or two pedestrians on one spot (see
+            :func:`~arena.tasks.scenario_checks.check_layout`).
     """
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise ConfigError(
-            f"malformed JSON at line {e.lineno}, column {e.colno}: {e.msg}", source=source
-        ) from None
+    data = files.parse_json(text, source=source)
     try:
         scenario = Scenario.model_validate(data)
     except ValidationError as e:
@@ -288,81 +337,22 @@ def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
                 obstacle_model(_model_name(o.model))
             except UnknownNameError as e:
                 raise e.located(source=source, prefix=f"obstacles.{group}[{i}].model") from None
+    from arena.tasks.scenario_checks import check_layout
+
+    check_layout(scenario, source=source)
     return scenario
 
 
 def load_scenario(path: str | Path) -> Scenario:
     """Read an Arena scenario JSON file (see :func:`parse_scenario` for the errors)."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as e:
-        raise ConfigError(f"cannot read scenario file: {e.strerror}", source=str(p)) from None
-    return parse_scenario(text, source=str(p))
+    return parse_scenario(files.read_text(p, what="scenario file"), source=str(p))
 
 
 def save_scenario(scenario: Scenario, path: str | Path) -> None:
     """Write ``scenario`` in Arena's format (indented JSON); loading it gives an equal value."""
     text = json.dumps(scenario.to_json_dict(), indent=2)
     Path(path).write_text(text + "\n", encoding="utf-8")
-
-
-# -- checks against a map -----------------------------------------------------------------------
-def _points(scenario: Scenario) -> list[tuple[str, Sequence[float], bool]]:
-    """Every position of the scenario as (key path, xy, must be free of walls)."""
-    pts: list[tuple[str, Sequence[float], bool]] = []
-    for i, r in enumerate(scenario.robots):
-        pts += [(f"robots[{i}].start", r.start, True), (f"robots[{i}].goal", r.goal, True)]
-    for group in ("static", "interactive"):
-        for i, o in enumerate(getattr(scenario.obstacles, group)):
-            # An obstacle may stand against (or partly in) a wall: only its being on the map
-            # is checked.
-            pts.append((f"obstacles.{group}[{i}].pos", o.pos, False))
-    for i, p in enumerate(scenario.obstacles.dynamic):
-        pts.append((f"obstacles.dynamic[{i}].pos", p.pos, True))
-        for j, w in enumerate(p.waypoints):
-            pts.append((f"obstacles.dynamic[{i}].waypoints[{j}]", w, True))
-    return pts
-
-
-def validate_against_map(
-    scenario: Scenario, grid: OccupancyGrid, *, source: str | None = None
-) -> list[str]:
-    """Check that every position lies on ``grid`` and robots/pedestrians are not in walls.
-
-    Args:
-        scenario: the scenario.
-        grid: the map it runs on.
-        source: the scenario file, for messages.
-
-    Returns:
-        Findings that are not errors (none at present; kept for the CLI's list).
-
-    Raises:
-        ConfigError: led by the first offending entry (e.g. ``obstacles.dynamic[3].waypoints[1]``),
-            followed by every other one.
-    """
-    xmin, ymin, xmax, ymax = grid.bounds
-    problems: list[tuple[str, str]] = []
-    for path, pos, must_be_free in _points(scenario):
-        xy = np.array([float(pos[0]), float(pos[1])])
-        where = f"({xy[0]:g}, {xy[1]:g})"
-        if not bool(grid.contains(xy)):
-            problems.append(
-                (
-                    path,
-                    f"{where} lies outside the map (x in [{xmin:g}, {xmax:g}], "
-                    f"y in [{ymin:g}, {ymax:g}])",
-                )
-            )
-        elif must_be_free and bool(grid.is_occupied(xy)):
-            problems.append((path, f"{where} lies inside a wall of the map"))
-    if problems:
-        # The first problem leads (file and key path first); the rest are listed after it.
-        (path, text), rest = problems[0], problems[1:]
-        more = "".join(f"; {p}: {t}" for p, t in rest)
-        raise ConfigError(text + more, source=source, path=path)
-    return []
 
 
 def validate_file(path: str | Path, map_yaml: str | Path | None = None) -> list[str]:
@@ -375,6 +365,7 @@ def validate_file(path: str | Path, map_yaml: str | Path | None = None) -> list[
         ConfigError: the first error, naming the file and the entry.
     """
     from arena.maps.io import load_map  # map images are only needed when a map is given
+    from arena.tasks.scenario_checks import validate_against_map
 
     scenario = load_scenario(path)
     findings = list(scenario.warnings)
@@ -478,7 +469,8 @@ def scenario_episode(
 
     Args:
         scenario: the loaded scenario.
-        grid: the map (not checked here; see :func:`validate_against_map`).
+        grid: the map (not checked here; see
+            :func:`~arena.tasks.scenario_checks.validate_against_map`).
         robots: the robot models, in scenario order.
         index: episode number.
         seed: the episode's seed.
@@ -534,6 +526,5 @@ __all__ = [
     "scenario_agents",
     "scenario_episode",
     "scenario_obstacles",
-    "validate_against_map",
     "validate_file",
 ]

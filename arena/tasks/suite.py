@@ -32,17 +32,22 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError, field_validator
 
 from arena.config.loader import merge
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, from_validation_error
-from arena.core.rng import child_seed
+from arena.core.names import RULE, SafeName
+from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, resolve_world
 from arena.tasks.datafiles import find_data_file, read_yaml_any
+
+MAX_EPISODES = 1_000_000
+"""Most episodes a (scaled) suite may have: weeks of simulation; more is a typo in a scale."""
 
 
 class _Arena(BaseModel):
@@ -67,7 +72,9 @@ class RandomClass(_Arena):
 class RandomBlock(_Arena):
     """Arena's ``RANDOM`` block."""
 
-    seed: int | None = Field(None, description="replaces the stage seed when >= 0 (-1: unset)")
+    seed: StrictInt | None = Field(
+        None, ge=-1, le=MAX_SEED, description="replaces the stage seed when >= 0 (-1: unset)"
+    )
     static: RandomClass | None = None
     interactive: RandomClass | None = None
     dynamic: RandomClass | None = None
@@ -110,8 +117,10 @@ class TaskOverlay(_Arena):
 class SuiteStage(_Arena):
     """One stage of a suite."""
 
-    name: str = Field(description="stage name (reports, output folders)")
-    episodes: int = Field(ge=0, description="episodes before scale_episodes")
+    name: SafeName = Field(description=f"stage name (reports, output folders): {RULE}")
+    episodes: int = Field(
+        ge=0, le=MAX_EPISODES, description="episodes before scale_episodes (<= 1,000,000)"
+    )
     robot: str | None = Field(None, description="robot preset or YAML; None: the run's")
     map: str | dict[str, Any] | None = Field(
         None, description="world name/folder, 'dynamic_map' or a map block; None: the run's"
@@ -120,23 +129,41 @@ class SuiteStage(_Arena):
     tm_obstacles: str = Field("random", description="obstacle task mode")
     config: TaskOverlay = Field(default_factory=TaskOverlay, description="Arena overlay")
     task: dict[str, Any] | None = Field(None, description="overlay in our task format")
-    seed: int | None = Field(None, ge=0, description="stage seed; default from SHA-1")
+    seed: Seed | None = Field(None, description="stage seed; default from SHA-1")
     timeout: float | None = Field(None, gt=0, description="s per episode; default: the run's")
     map_per_episode: bool = Field(
         True, description="a generated map gets a new instance every episode"
     )
 
 
+def _unique_names(items: list[Any], what: str) -> list[Any]:
+    """Refuse two entries with one name: they would share one results folder."""
+    seen: dict[str, int] = {}
+    for i, item in enumerate(items):
+        if item.name in seen:
+            raise ValueError(
+                f"[{seen[item.name]}] and [{i}] are both named {item.name!r}; {what} names must "
+                "be unique (each names a results folder: two would mix their results)"
+            )
+        seen[item.name] = i
+    return items
+
+
 class SuiteFile(_Arena):
     """``suites/<name>.yaml``."""
 
-    stages: list[SuiteStage] = Field(min_length=1)
+    stages: list[SuiteStage] = Field(min_length=1, description="stages, unique names")
+
+    @field_validator("stages")
+    @classmethod
+    def _unique(cls, v: list[SuiteStage]) -> list[SuiteStage]:
+        return _unique_names(v, "stage")
 
 
 class Contestant(_Arena):
     """One contestant: a navigation stack."""
 
-    name: str
+    name: SafeName = Field(description=f"contestant name (reports, output folders): {RULE}")
     local_planner: str = Field(description="local planner name")
     inter_planner: str = Field("bypass", description="Arena's intermediate planner")
     params: dict[str, Any] = Field(
@@ -149,7 +176,12 @@ class Contestant(_Arena):
 class ContestFile(_Arena):
     """``contests/<name>.yaml``."""
 
-    contestants: list[Contestant] = Field(min_length=1)
+    contestants: list[Contestant] = Field(min_length=1, description="contestants, unique names")
+
+    @field_validator("contestants")
+    @classmethod
+    def _unique(cls, v: list[Contestant]) -> list[Contestant]:
+        return _unique_names(v, "contestant")
 
 
 class SuiteRef(_Arena):
@@ -210,8 +242,15 @@ class Suite:
     def __init__(
         self, file: SuiteFile, raw: list[dict[str, Any]], source: str, scale_episodes: float = 1.0
     ) -> None:
-        if scale_episodes <= 0:
-            raise ConfigError(f"scale_episodes must be > 0, got {scale_episodes}", source=source)
+        if not (math.isfinite(scale_episodes) and scale_episodes > 0):
+            raise ConfigError(f"scale_episodes must be a finite number > 0, got {scale_episodes}",
+                              source=source)
+        total = sum(st.episodes for st in file.stages) * scale_episodes
+        if total > MAX_EPISODES:
+            raise ConfigError(
+                f"scale_episodes {scale_episodes:g} gives {total:.3g} episodes; a suite has at "
+                f"most {MAX_EPISODES:,}", source=source,
+            )
         self.stages = list(file.stages)
         self.source = source
         self.scale_episodes = float(scale_episodes)

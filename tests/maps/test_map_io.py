@@ -345,7 +345,7 @@ def test_malformed_yaml_names_line(tmp_path):
     msg = _error(p)
     assert "bad_map.yaml" in msg
     assert "line 3" in msg
-    assert "invalid YAML" in msg
+    assert "malformed YAML" in msg
 
 
 def test_yaml_not_a_mapping(tmp_path):

@@ -240,6 +240,8 @@ def test_thin_walls_survive_zoomed_out_frames() -> None:
 def test_bad_arguments(world: StaticWorld) -> None:
     with pytest.raises(ConfigError):
         FrameRenderer(world, width_px=4)
+    with pytest.raises(ConfigError, match=r"width_px must lie in \[16, 8000\] pixels"):
+        FrameRenderer(world, width_px=100_000_000)  # arena maps generate --width-px
     with pytest.raises(ConfigError):
         FrameRenderer(world, margin_m=-1.0)
 

@@ -27,9 +27,9 @@ from arena.tasks.scenario import (
     parse_scenario,
     save_scenario,
     scenario_episode,
-    validate_against_map,
     validate_file,
 )
+from arena.tasks.scenario_checks import validate_against_map
 
 
 def ped(name: str, pos: list[float], waypoints: list[list[float]], **kw: Any) -> dict[str, Any]:

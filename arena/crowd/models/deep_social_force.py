@@ -67,8 +67,10 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from arena.core import files
+from arena.core.errors import ConfigError
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.models.evacuation import SegmentWalls, SubstepMemory
 from arena.crowd.walls import world_segments
@@ -116,10 +118,33 @@ class MLPPotential:
 
     @classmethod
     def load(cls, path: str | Path = WEIGHTS) -> MLPPotential:
-        """Read weights written by ``tools/train_deep_social_force.py``."""
-        with np.load(Path(path), allow_pickle=False) as z:
-            meta = json.loads(str(z["metadata"])) if "metadata" in z.files else {}
-            return cls(z["w1"], z["b1"], z["w2"], float(z["b2"]), meta)
+        """Read weights written by ``tools/train_deep_social_force.py``.
+
+        Raises:
+            ConfigError: not such a file: no ``.npz``, pickled data, missing arrays ``w1, b1,
+                w2, b2``, non-numeric or mismatched shapes, metadata that is not JSON.
+        """
+        what = "deep_social_force weights file (.npz with w1, b1, w2, b2)"
+        z = files.read_npz(path, ("w1", "b1", "w2", "b2"), what=what)
+        source = str(path)
+        for k in ("w1", "b1", "w2", "b2"):
+            if z[k].dtype.kind not in "fiu":
+                raise ConfigError(f"array {k!r} is not numeric ({z[k].dtype})", source=source)
+        if not (z["w1"].ndim == z["b1"].ndim == z["w2"].ndim == 1
+                and z["w1"].shape == z["b1"].shape == z["w2"].shape and z["w1"].size > 0
+                and z["b2"].size == 1):
+            raise ConfigError(
+                f"w1, b1, w2 must be 1-D of one length and b2 one number; got shapes "
+                f"{[tuple(z[k].shape) for k in ('w1', 'b1', 'w2', 'b2')]}", source=source,
+            )
+        meta: Any = {}
+        if "metadata" in z:
+            try:
+                meta = json.loads(str(z["metadata"]))
+            except ValueError:
+                raise ConfigError("'metadata' is not JSON text", source=source) from None
+        return cls(z["w1"], z["b1"], z["w2"], float(z["b2"].reshape(-1)[0]),
+                   meta if isinstance(meta, dict) else {})
 
     @property
     def hidden(self) -> int:
@@ -171,8 +196,18 @@ class DeepSocialForce:
         weights: str | None = Field(
             None,
             description="path to an .npz from tools/train_deep_social_force.py "
-            "(default: the shipped weights)",
+            "(default: the shipped weights); read and checked when the config is loaded",
         )
+
+        @field_validator("weights")
+        @classmethod
+        def _readable(cls, v: str | None) -> str | None:
+            if v is not None:
+                try:
+                    MLPPotential.load(v)
+                except ConfigError as e:  # pydantic's location then names crowd.weights
+                    raise ValueError(str(e)) from None
+            return v
         v0: float = Field(
             2.1, ge=0, description="m²/s², analytic potential strength (socialforce default)"
         )

@@ -30,13 +30,13 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import ConfigDict, Field, model_validator
 from scipy import ndimage
 
 from arena.core.errors import MapError
 from arena.maps.generators.base import register_generator
 from arena.maps.grid import OccupancyGrid
-from arena.maps.sources import MapResult
+from arena.maps.sources import GridSizeParams, MapResult
 
 # 8-neighbour kernel of the automaton (the cell itself is not its own neighbour).
 _NEIGHBOURS = np.array([[1, 1, 1], [1, 0, 1], [1, 1, 1]], dtype=np.int16)
@@ -51,7 +51,7 @@ def _whole_ratio(a: float, b: float) -> int | None:
     return n if n >= 1 and abs(q - n) <= 1e-6 * max(1.0, q) else None
 
 
-class GeneratorGridParams(BaseModel):
+class GeneratorGridParams(GridSizeParams):
     """Map size and cell sizes shared by the barn and rosnav generators.
 
     Defaults are Arena-Rosnav's 2024 ``arena_bringup/params/map_generator.yaml``: 60 × 60 cells at

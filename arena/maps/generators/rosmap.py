@@ -27,20 +27,20 @@ from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import ConfigDict, Field
 
 from arena.core.geometry import point_segment_distance, polygon_edges, polygons_overlap
 from arena.maps.generators.base import register_generator
 from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle, obstacle_model
-from arena.maps.sources import MapResult
+from arena.maps.sources import GridSizeParams, MapResult
 from arena.sim.state import Obstacle
 
 Placement = tuple[str, float, float, float]
 """One obstacle of a placement: ``(model, x, y, yaw)`` in metres / radians."""
 
 
-class RoomParams(BaseModel):
+class RoomParams(GridSizeParams):
     """Parameters shared by every ``rosmap`` generator."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")

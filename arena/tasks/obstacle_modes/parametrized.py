@@ -41,7 +41,7 @@ from arena.core.errors import ConfigError
 from arena.maps.obstacles import obstacle_models
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import AgentSpawn
+from arena.tasks.episode import MAX_COUNT, AgentSpawn
 from arena.tasks.obstacle_modes.random import (
     BOX,
     PlacementParams,
@@ -171,8 +171,8 @@ def _entry(el: ET.Element, section: str, where: str, source: str) -> Parametrize
             n = int(values[key])
         except ValueError:
             raise fail(f"expected an integer >= 0, got {values[key]!r}", key) from None
-        if n < 0:
-            raise fail(f"expected an integer >= 0, got {n}", key)
+        if not 0 <= n <= MAX_COUNT:
+            raise fail(f"expected an integer in [0, {MAX_COUNT:,}], got {n}", key)
         return n
 
     lo = count("min", None)

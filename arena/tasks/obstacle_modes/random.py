@@ -27,7 +27,13 @@ from arena.maps.obstacles import make_obstacle, obstacle_models
 from arena.maps.raster import polygon_mask, polygon_window
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn
+from arena.tasks.episode import (
+    MAX_COUNT,
+    MAX_PERSON_SPEED,
+    WAYPOINT_LOOP,
+    AgentSpawn,
+    speed_range_problem,
+)
 from arena.tasks.sampling import (
     MaskRegions,
     clear_near,
@@ -44,8 +50,8 @@ class Count(BaseModel):
     """How many of one obstacle class: ``n``, ``[min, max]`` or ``{min, max, models}``."""
 
     model_config = ConfigDict(frozen=True, extra="forbid")
-    min: int = Field(0, ge=0)
-    max: int = Field(0, ge=0)
+    min: int = Field(0, ge=0, le=MAX_COUNT, description=f"fewest; 0 to {MAX_COUNT:,}")
+    max: int = Field(0, ge=0, le=MAX_COUNT, description=f"most; 0 to {MAX_COUNT:,}")
     models: list[str] = Field(
         default_factory=lambda: [BOX], description="models drawn uniformly (static classes)"
     )
@@ -83,7 +89,10 @@ class PlacementParams(BaseModel):
     )
     obstacle_clearance: float = Field(0.6, ge=0, description="m, free gap kept around obstacles")
     agent_radius: float = Field(0.3, gt=0, description="m (Arena's pedestrian body: 0.3-0.32)")
-    agent_speed: tuple[float, float] = Field((0.5, 1.2), description="m/s, [min, max] vmax")
+    agent_speed: tuple[float, float] = Field(
+        (0.5, 1.2),
+        description=f"m/s, [min, max] vmax; 0 <= min <= max <= {MAX_PERSON_SPEED:g}",
+    )
     agent_waypoints: int = Field(
         2, ge=1, description="waypoints per pedestrian beside its start"
     )
@@ -97,10 +106,13 @@ class PlacementParams(BaseModel):
 
     @model_validator(mode="after")
     def _ranges(self) -> PlacementParams:
-        for name in ("box_size", "agent_speed", "agent_leg_length"):
+        for name in ("box_size", "agent_leg_length"):
             lo, hi = getattr(self, name)
             if not 0 < lo <= hi:
                 raise ValueError(f"{name} must be [min, max] with 0 < min <= max, got {[lo, hi]}")
+        problem = speed_range_problem(*self.agent_speed)
+        if problem:
+            raise ValueError(f"agent_speed {problem}")
         return self
 
 

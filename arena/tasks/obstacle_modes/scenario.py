@@ -12,8 +12,9 @@ from arena.core.errors import ConfigError
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import AgentSpawn
-from arena.tasks.robot_modes.scenario import ScenarioFile
+from arena.tasks.robot_modes.scenario import ScenarioFile, ScenarioRobots
 from arena.tasks.scenario import scenario_agents, scenario_obstacles
+from arena.tasks.scenario_checks import check_robot_bodies
 
 
 @register_mode("obstacles", "scenario", tags=("file",))
@@ -40,5 +41,11 @@ class ScenarioObstacles:
                 self._obstacles = scenario_obstacles(sc)
             except ConfigError as e:
                 raise e.located(source=self.params.file) from None
+        if self.params.check_map and isinstance(ctx.robot_mode, ScenarioRobots):
+            # The robots come from the file too: their bodies must clear its obstacles (robots
+            # of other modes were placed around them by the sampler).
+            assert ctx.map_result is not None
+            check_robot_bodies(ctx.spawns, ctx.map_result.grid, self._obstacles,
+                               source=self.params.file)
         ctx.sampler.add_obstacles(self._obstacles)
         return list(self._obstacles), scenario_agents(sc.obstacles.dynamic, ctx.rng("scenario"))

@@ -24,7 +24,7 @@ from pydantic import Field, model_validator
 
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn
+from arena.tasks.episode import MAX_PERSON_SPEED, WAYPOINT_LOOP, AgentSpawn, speed_range_problem
 from arena.tasks.zones import ZoneFileParams, ZoneFiles, sample_in_zones
 
 
@@ -36,7 +36,10 @@ class ZoneObstacles:
         """Parameters of ``obstacles.zones``."""
 
         agent_radius: float = Field(0.3, gt=0, description="m, pedestrian body radius")
-        agent_speed: tuple[float, float] = Field((0.5, 1.2), description="m/s, [min, max] vmax")
+        agent_speed: tuple[float, float] = Field(
+            (0.5, 1.2),
+            description=f"m/s, [min, max] vmax; 0 <= min <= max <= {MAX_PERSON_SPEED:g}",
+        )
         agent_robot_clearance: float = Field(
             1.5, ge=0, description="m, no pedestrian starts this close to a robot's start"
         )
@@ -46,11 +49,9 @@ class ZoneObstacles:
 
         @model_validator(mode="after")
         def _speed(self) -> ZoneObstacles.Params:
-            lo, hi = self.agent_speed
-            if not 0 < lo <= hi:
-                raise ValueError(
-                    f"agent_speed must be [min, max] with 0 < min <= max, got {[lo, hi]}"
-                )
+            problem = speed_range_problem(*self.agent_speed)
+            if problem:
+                raise ValueError(f"agent_speed {problem}")
             return self
 
     def __init__(self, params: Params | None = None) -> None:

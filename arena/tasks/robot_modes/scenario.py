@@ -15,7 +15,8 @@ from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, SingleGoal, register_mode
 from arena.tasks.episode import RobotSpawn
 from arena.tasks.robot_modes.random import robot_name
-from arena.tasks.scenario import Scenario, load_scenario, validate_against_map
+from arena.tasks.scenario import Scenario, load_scenario
+from arena.tasks.scenario_checks import check_layout, check_robot_bodies, validate_against_map
 
 
 class ScenarioFile:
@@ -47,7 +48,11 @@ class ScenarioRobots(SingleGoal):
 
         model_config = ConfigDict(frozen=True, extra="forbid")
         file: str = Field(description="path to an Arena scenario JSON file")
-        check_map: bool = Field(True, description="reject positions off the map or in walls")
+        check_map: bool = Field(
+            True,
+            description="reject positions off the map or in walls, and starts/goals where the "
+            "robot's footprint overlaps a wall or an obstacle",
+        )
         clearance: float = Field(
             0.25, ge=0, description="m beyond the robot radius forbidden around start and goal"
         )
@@ -73,4 +78,9 @@ class ScenarioRobots(SingleGoal):
             for p in (start, goal):
                 ctx.sampler.forbid(p.xy, model.radius + self.params.clearance)
             spawns.append(RobotSpawn(robot_name(k, n, model.name), model, start, goal))
+        if self.params.check_map:
+            check_layout(sc, goal_radius=ctx.goal_radius, source=self.params.file)
+            assert ctx.map_result is not None  # the generator builds the map first
+            check_robot_bodies(spawns, ctx.map_result.grid, ctx.map_result.obstacles,
+                               source=self.params.file)
         return spawns
