@@ -566,7 +566,8 @@ def run_experiment(
     n_episodes = generator.num_episodes or cfg.episodes
     # Draw the first episode before writing anything: a bad map or task fails with no output.
     first = generator.episode(0)
-    out = make_dir(Path(out_dir or cfg.output.dir or default_output_dir(cfg)))
+    out = make_dir(Path(out_dir or cfg.output.dir or default_output_dir(cfg)),
+                   what="output folder (output.dir, -o)")
     (out / "config.yaml").write_text(yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False))
     results: list[EpisodeResult] = []
     for i in range(n_episodes):

@@ -170,25 +170,26 @@ def corpus(tmp_path_factory) -> Path:
     run = d / "tampered_run"  # a run folder whose row names a contestant ../../../../X
     (run / "episodes" / "X" / "s1").mkdir(parents=True)
     (run / "run.json").write_text(json.dumps({"suite": "quick", "contest": "basic", "seed": 0}))
-    row = {"contestant": "../../../../X", "stage": "s1", "episode": 0, "outcome": "success",
-           "record": ""}
+    row = {**ROW, "contestant": "../../../../X", "record": ""}
     (run / "episodes" / "X" / "s1" / "0000.json").write_text(json.dumps(row))
     run2 = d / "tampered_record"
     (run2 / "episodes" / "X" / "s1").mkdir(parents=True)
     (run2 / "run.json").write_text("{}")
-    row = {"contestant": "X", "stage": "s1", "episode": 0, "outcome": "success",
-           "record": "../../../etc/passwd"}
+    row = {**ROW, "record": "../../../etc/passwd"}
     (run2 / "episodes" / "X" / "s1" / "0000.json").write_text(json.dumps(row))
     run3 = d / "corrupt_record"  # a row whose parquet record is garbage
     (run3 / "episodes" / "X" / "s1").mkdir(parents=True)
     (run3 / "run.json").write_text("{}")
-    row = {"contestant": "X", "stage": "s1", "episode": 0, "outcome": "success",
-           "record": "episodes/X/s1/0000.parquet", "time": 1.0}
+    row = {**ROW, "record": "episodes/X/s1/0000.parquet"}
     (run3 / "episodes" / "X" / "s1" / "0000.json").write_text(json.dumps(row))
     (run3 / "episodes" / "X" / "s1" / "0000.parquet").write_text("garbage")
     return d
 
 
+# A well-formed stored episode row (as commit_episode writes it) of contestant X, stage s1.
+ROW = {"contestant": "X", "local_planner": "dwa", "inter_planner": "", "stage": "s1",
+       "episode": 0, "seed": 0, "map": "m", "robot": "jackal", "outcome": "success", "time": 1.0,
+       "path_length": 1.0, "collisions": 0, "wall_time": 1.0, "error": "", "record": ""}
 LONG = "x" * 300
 EMPTY_MAP = ["map.type=empty", "map.width=10", "map.height=10"]
 Q = "task.obstacles.dynamic=0"  # fewer people: the cases that reach the first draw stay quick

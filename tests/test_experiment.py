@@ -242,5 +242,5 @@ def test_output_folder_that_cannot_be_made_is_a_one_line_error(where, tmp_path):
               "long_name": tmp_path / ("x" * 300)}[where]
     if where == "file":
         target.write_text("mine")
-    with pytest.raises(ArenaError, match=r"cannot create the output folder \(output\.dir, -o\)"):
+    with pytest.raises(ArenaError, match=r"output folder \(output\.dir, -o\)"):
         run_experiment(load_config(None, FAST), Path(target))

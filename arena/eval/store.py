@@ -253,8 +253,11 @@ def _check_row(run: Path, path: Path, row: Any) -> dict[str, Any]:
         ):
             raise ArenaError(f"{path}: metric {name!r}: expected a number or null, "
                              f"got {value!r}{redo}")
-    for key in ("contestant", "stage"):
-        check_name(row[key], f"{key} name", source=str(path), path=key)
+    for key in ("contestant", "stage"):  # these become paths in reports
+        try:
+            check_name(row[key], f"{key} name", source=str(path), path=key)
+        except ConfigError as e:
+            raise ArenaError(f"{e}{redo}") from None
     place = (path.parent.parent.name, path.parent.name, path.stem)
     if (row["contestant"], row["stage"], f"{row['episode']:04d}") != place:
         raise ArenaError(f"{path}: the row is of {row['contestant']}/{row['stage']}/"

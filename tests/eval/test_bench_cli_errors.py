@@ -181,7 +181,8 @@ def test_resume_with_a_corrupt_manifest(content: bytes, fragment: str, finished_
     ('{"contestant": "pp"}', "field 'local_planner': expected string, got None"),
     ("EPISODE_STR", "field 'episode': expected int64, got '0'"),
     ("METRIC_STR", "metric 'success': expected a number or null, got 'yes'"),
-    ("OTHER_PLACE", "the row is of ../x/open/0, not of the episode its file name says"),
+    ("OTHER_PLACE", "the row is of other/open/0, not of the episode its file name says"),
+    ("UNSAFE_NAME", "contestant name '../x' cannot be a file name"),
 ])
 def test_resume_with_a_corrupt_episode_row(content: str, fragment: str, finished_run: Path,
                                            tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
@@ -195,6 +196,8 @@ def test_resume_with_a_corrupt_episode_row(content: str, fragment: str, finished
     elif content == "METRIC_STR":
         content = json.dumps({**row, "success": "yes"})
     elif content == "OTHER_PLACE":
+        content = json.dumps({**row, "contestant": "other"})
+    elif content == "UNSAFE_NAME":
         content = json.dumps({**row, "contestant": "../x"})
     row_file.write_text(content)
     suite = json.loads((run / "run.json").read_text())["suite"]
