@@ -33,8 +33,11 @@ MAX_COORDINATE = 1e6
 cells apart any more (1e20 + 0.05 == 1e20); 1000 km covers any building's map frame."""
 
 
-def check_grid_size(width_m: float, height_m: float, resolution: float) -> tuple[int, int]:
+def check_grid_size(width_m: float, height_m: float, resolution: float, *,
+                    min_cells: int = MIN_CELLS) -> tuple[int, int]:
     """The ``(rows, cols)`` of a ``width_m × height_m`` map at ``resolution`` (m).
+
+    ``min_cells`` is the fewest cells a side may have (a map without walls may have 1).
 
     Raises:
         MapError: a size is not a finite positive number, a side has fewer than
@@ -45,10 +48,10 @@ def check_grid_size(width_m: float, height_m: float, resolution: float) -> tuple
         if not (isinstance(v, int | float) and np.isfinite(v) and v > 0):
             raise MapError(f"{label} must be a finite number > 0 (m), got {v!r}")
     rows, cols = round(height_m / resolution), round(width_m / resolution)
-    if min(rows, cols) < MIN_CELLS:
+    if min(rows, cols) < min_cells:
         raise MapError(
             f"a {width_m:g} × {height_m:g} m map at resolution {resolution:g} m has "
-            f"{cols} × {rows} cells; each side needs at least {MIN_CELLS} (lower the resolution)"
+            f"{cols} × {rows} cells; each side needs at least {min_cells} (lower the resolution)"
         )
     if rows * cols > MAX_CELLS:
         raise MapError(
@@ -130,7 +133,7 @@ class OccupancyGrid:
         Raises:
             MapError: see :func:`check_grid_size`.
         """
-        h, w = check_grid_size(width_m, height_m, resolution)
+        h, w = check_grid_size(width_m, height_m, resolution, min_cells=MIN_CELLS if walls else 1)
         occ = np.zeros((h, w), dtype=bool)
         if walls:
             occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
