@@ -48,26 +48,53 @@ def polygon_distance(points: FloatArray, polygon: FloatArray) -> FloatArray:
     return polygons_distance(points, [polygon])
 
 
-def polygons_distance(points: FloatArray, polygons: Sequence[FloatArray]) -> FloatArray:
+def polygons_distance(
+    points: FloatArray, polygons: Sequence[FloatArray], *, cutoff: float = np.inf
+) -> FloatArray:
     """Distance (m) from ``(n, 2)`` points to the nearest of some filled polygons; ``inf`` if none.
 
     The minimum over ``polygons`` (each ``(k, 2)``, ``k ≥ 1``) of :func:`polygon_distance`.
+    With a finite ``cutoff`` (m), distances below it are still exact (bit for bit), while one
+    of ``cutoff`` or more may come back as any value ``≥ cutoff``: polygons whose bounding box
+    is farther than that are skipped, which is all ``distance >= clearance`` tests need.
     """
-    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    return packed_distance(points, pack_polygons(polygons), cutoff=cutoff)
+
+
+@dataclass(frozen=True, eq=False)
+class PackedPolygons:
+    """Polygons as one array: polygon ``g`` is ``verts[offsets[g]:offsets[g + 1]]`` (m)."""
+
+    verts: FloatArray
+    offsets: NDArray[np.int64]
+
+
+def pack_polygons(polygons: Sequence[FloatArray]) -> PackedPolygons:
+    """Pack ``(k, 2)`` polygons (``k ≥ 1``) for :func:`packed_distance` (callers keep it)."""
     polys = [np.asarray(q, dtype=np.float64) for q in polygons]
-    if not polys:
-        return np.full(len(p), np.inf)
     if any(len(q) == 0 for q in polys):  # the vectorised form's error for an empty polygon
         raise ValueError("zero-size array to reduction operation minimum which has no identity")
-    offsets = np.cumsum([0] + [len(q) for q in polys])
-    verts = np.ascontiguousarray(np.concatenate(polys).reshape(-1, 2))
-    distance: FloatArray = _polygons_distance(p, verts, offsets)
+    offsets = np.cumsum([0] + [len(q) for q in polys]).astype(np.int64)
+    verts = np.concatenate(polys).reshape(-1, 2) if polys else np.zeros((0, 2))
+    return PackedPolygons(np.ascontiguousarray(verts, dtype=np.float64), offsets)
+
+
+def packed_distance(
+    points: FloatArray, polygons: PackedPolygons, *, cutoff: float = np.inf
+) -> FloatArray:
+    """:func:`polygons_distance` of packed polygons."""
+    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    if len(polygons.offsets) < 2:
+        return np.full(len(p), np.inf)
+    distance: FloatArray = _polygons_distance(
+        p, polygons.verts, polygons.offsets, float(cutoff)
+    )
     return distance
 
 
 @njit(cache=True, error_model="numpy")
 def _polygons_distance(
-    p: FloatArray, verts: FloatArray, offsets: NDArray[np.int64]
+    p: FloatArray, verts: FloatArray, offsets: NDArray[np.int64], cutoff: float
 ) -> FloatArray:
     """Polygon ``g`` has vertices ``verts[offsets[g]:offsets[g + 1]]``.
 
@@ -77,15 +104,29 @@ def _polygons_distance(
     :func:`~arena.core.geometry.point_segment_distance` (``t`` clipped to [0, 1], NaN → 0;
     ``sqrt(dx² + dy²)``), and NaN propagates through the minima as through ``np.minimum``:
     the same distances, without a dozen numpy temporaries per polygon and batch.
+
+    A point whose gap to a polygon's bounding box, along x or y, exceeds ``cutoff`` (with a
+    relative margin of 1e-9 of the magnitudes involved, far above rounding) skips that
+    polygon: its distance to it is larger still, so the minimum is exact wherever it is
+    below ``cutoff``. NaN coordinates never skip.
     """
     n = p.shape[0]
     out = np.full(n, np.inf)
     for g in range(offsets.shape[0] - 1):
         s = offsets[g]
         k = offsets[g + 1] - s
+        bx0 = bx1 = verts[s, 0]
+        by0 = by1 = verts[s, 1]
+        for e in range(1, k):
+            bx0, bx1 = min(bx0, verts[s + e, 0]), max(bx1, verts[s + e, 0])
+            by0, by1 = min(by0, verts[s + e, 1]), max(by1, verts[s + e, 1])
         for i in range(n):
             px = p[i, 0]
             py = p[i, 1]
+            gap = max(bx0 - px, px - bx1, by0 - py, py - by1)
+            scale = abs(cutoff) + abs(px) + abs(py) + max(abs(bx0), abs(bx1), abs(by0), abs(by1))
+            if gap > cutoff + 1e-9 * scale:
+                continue
             crossings = 0
             best = np.inf
             for e in range(k):
@@ -120,26 +161,75 @@ def _minimum(a: float, b: float) -> float:
 def _accept(candidates: FloatArray, chosen: FloatArray, count: int, min_gap: float) -> int:
     """Append to ``chosen[:count]`` each candidate ≥ ``min_gap`` from all chosen so far.
 
-    ``chosen`` ``(n, 2)`` fills up to ``n`` rows; returns the new count. The test is the one
-    it replaced, ``np.hypot(*(p - q)) >= min_gap`` per pair (the same ``hypot``), in a loop
-    that was a reset's largest Python cost.
+    Candidates are taken in their order; candidate ``m`` is accepted if
+    ``np.hypot(*(p - q)) >= min_gap`` for every chosen ``q`` (the earlier candidates accepted
+    included), until ``chosen`` ``(n, 2)`` holds ``n`` rows; returns the new count. All
+    coordinates must be finite (m).
+
+    Only the pairs that can fail are tested: the points are binned into square buckets of
+    side ``size ≥ min_gap · (1 + 1e-6)``, and points two or more buckets apart (in x or y)
+    differ by more than ``min_gap`` in that coordinate, so their ``hypot`` passes. The
+    outcome is therefore that of testing every pair (the loop this replaced, O(candidates ×
+    chosen), took minutes for 1,000 people), in O(candidates + chosen) for a bounded density.
     """
     n = chosen.shape[0]
-    for m in range(candidates.shape[0]):
+    m = candidates.shape[0]
+    if m == 0 or count >= n:
+        return count
+    # Bounding box of everything that can be binned.
+    x0 = y0 = np.inf
+    x1 = y1 = -np.inf
+    for j in range(count):
+        x0, x1 = min(x0, chosen[j, 0]), max(x1, chosen[j, 0])
+        y0, y1 = min(y0, chosen[j, 1]), max(y1, chosen[j, 1])
+    for i in range(m):
+        x0, x1 = min(x0, candidates[i, 0]), max(x1, candidates[i, 0])
+        y0, y1 = min(y0, candidates[i, 1]), max(y1, candidates[i, 1])
+    # Bucket side: a hair above the gap (rounding of the bucket indices), and large enough
+    # that there are at most about 4 buckets per point (memory O(points)).
+    size = min_gap * (1.0 + 1e-6) if min_gap > 0.0 else 1.0
+    cap = 4 * (n + m) + 16
+    while (np.floor((x1 - x0) / size) + 1.0) * (np.floor((y1 - y0) / size) + 1.0) > cap:
+        size *= 2.0
+    nbx = int((x1 - x0) / size) + 1
+    nby = int((y1 - y0) / size) + 1
+    head = np.full(nbx * nby, -1, dtype=np.int64)  # first chosen point of each bucket
+    nxt = np.empty(n, dtype=np.int64)  # the next one in the same bucket
+    for j in range(count):
+        b = _bucket(chosen[j, 0], chosen[j, 1], x0, y0, size, nbx, nby)
+        nxt[j] = head[b]
+        head[b] = j
+    for i in range(m):
         if count == n:
             break
-        px = candidates[m, 0]
-        py = candidates[m, 1]
+        px = candidates[i, 0]
+        py = candidates[i, 1]
+        b = _bucket(px, py, x0, y0, size, nbx, nby)
+        bx = b % nbx
+        by = b // nbx
         free = True
-        for j in range(count):
-            if not np.hypot(px - chosen[j, 0], py - chosen[j, 1]) >= min_gap:
-                free = False
-                break
+        for yy in range(max(by - 1, 0), min(by + 2, nby)):
+            for xx in range(max(bx - 1, 0), min(bx + 2, nbx)):
+                j = head[yy * nbx + xx]
+                while j >= 0 and free:
+                    if not np.hypot(px - chosen[j, 0], py - chosen[j, 1]) >= min_gap:
+                        free = False
+                    j = nxt[j]
         if free:
             chosen[count, 0] = px
             chosen[count, 1] = py
+            nxt[count] = head[b]
+            head[b] = count
             count += 1
     return count
+
+
+@njit(cache=True)
+def _bucket(x: float, y: float, x0: float, y0: float, size: float, nbx: int, nby: int) -> int:
+    """Flat index of the bucket of ``(x, y)`` (clamped: clamping keeps neighbours adjacent)."""
+    bx = min(max(int((x - x0) / size), 0), nbx - 1)
+    by = min(max(int((y - y0) / size), 0), nby - 1)
+    return by * nbx + bx
 
 
 def wall_distance_map(grid: OccupancyGrid) -> FloatArray:
@@ -177,9 +267,12 @@ class WorldSampler:
         self.grid = grid
         self._wall = wall_distance if wall_distance is not None else wall_distance_map(grid)
         self._polygons: list[FloatArray] = []
+        self._packed: PackedPolygons | None = None  # of _polygons, None once they change
         self._forbidden_discs: list[ForbiddenDisc] = []
         self._forbidden_polygons: list[FloatArray] = []
         self._blocked_cache: NDArray[np.bool_] | None = None
+        # (pad, distance map) of the blocked cells for `_surely_taken`; None once they change.
+        self._blocked_edt: tuple[int, FloatArray] | None = None
         self._free_cache: NDArray[np.intp] | None = None
         self.add_obstacles(obstacles)
 
@@ -188,6 +281,8 @@ class WorldSampler:
         """Add obstacle footprints to the obstacle layer."""
         polys = [np.asarray(o.polygon, dtype=np.float64) for o in obstacles]
         self._polygons.extend(polys)
+        self._packed = None
+        self._blocked_edt = None
         if self._blocked_cache is not None:  # update in place: O(new shapes)
             for poly in polys:
                 self._or_polygon(self._blocked_cache, poly)
@@ -196,6 +291,7 @@ class WorldSampler:
         """Add a forbidden disc (Arena adds every robot start and goal this way)."""
         zone = ForbiddenDisc(float(xy[0]), float(xy[1]), float(radius))
         self._forbidden_discs.append(zone)
+        self._blocked_edt = None
         if self._blocked_cache is not None:
             or_disk(self._blocked_cache, self.grid, zone.x, zone.y, zone.radius)
 
@@ -203,6 +299,7 @@ class WorldSampler:
         """Add a forbidden polygon (m)."""
         poly = np.asarray(polygon, dtype=np.float64)
         self._forbidden_polygons.append(poly)
+        self._blocked_edt = None
         if self._blocked_cache is not None:
             self._or_polygon(self._blocked_cache, poly)
 
@@ -217,6 +314,7 @@ class WorldSampler:
         """Empty the forbidden layer (module ``clear_forbidden_zones``)."""
         self._forbidden_discs.clear()
         self._forbidden_polygons.clear()
+        self._blocked_edt = None
         self._blocked_cache = None
 
     @property
@@ -267,9 +365,14 @@ class WorldSampler:
             out[i] = best
         return out
 
-    def obstacle_distance(self, points: FloatArray) -> FloatArray:
-        """Distance (m) from points to the nearest obstacle footprint (``inf`` if none)."""
-        return polygons_distance(points, self._polygons)
+    def obstacle_distance(self, points: FloatArray, *, cutoff: float = np.inf) -> FloatArray:
+        """Distance (m) from points to the nearest obstacle footprint (``inf`` if none).
+
+        ``cutoff`` as in :func:`polygons_distance`: exact below it.
+        """
+        if self._packed is None:
+            self._packed = pack_polygons(self._polygons)
+        return packed_distance(points, self._packed, cutoff=cutoff)
 
     def forbidden_distance(self, points: FloatArray) -> FloatArray:
         """Distance (m) from points to the nearest forbidden zone (``inf`` if none)."""
@@ -411,10 +514,7 @@ class WorldSampler:
         if count < n:
             if flat is None:
                 flat = np.flatnonzero(self.candidate_mask(clearance))
-            found = self._exhaustive(
-                flat, shape, n, list(chosen[:count]), clearance, polygon, rng, what
-            )
-            chosen = np.array(found[:n], dtype=np.float64).reshape(n, 2)
+            self._exhaustive(flat, shape, chosen, count, clearance, polygon, rng, what)
         if forbid:
             for p in chosen:
                 self.forbid(p, clearance)
@@ -434,34 +534,71 @@ class WorldSampler:
         self,
         flat: NDArray[np.intp],
         shape: tuple[int, ...],
-        n: int,
-        chosen: list[FloatArray],
+        chosen: FloatArray,
+        count: int,
         clearance: float,
         polygon: FloatArray | None,
         rng: np.random.Generator,
         what: str,
-    ) -> list[FloatArray]:
-        """Last attempt: every candidate cell centre in random order (fails only if none fit)."""
+    ) -> None:
+        """Last attempt: every candidate cell centre in random order (fails only if none fit).
+
+        Fills ``chosen`` ``(n, 2)`` beyond its first ``count`` rows, in place. The candidates
+        are tested in chunks, in that order, up to the one that completes ``chosen``: a
+        request for one position (each placed obstacle) rarely needs more than the first.
+        """
+        n = len(chosen)
         if flat.size:
             order = rng.permutation(flat)
-            cells = np.stack(np.unravel_index(order, shape), axis=1)
-            pts = self.grid.cell_to_world(cells)
-            ok = self._admissible(pts, clearance, polygon)
-            for p in pts[ok]:
-                if all(np.hypot(*(p - q)) >= 2 * clearance for q in chosen):
-                    chosen.append(p)
-                    if len(chosen) == n:
-                        return chosen
+            order = order[~self._surely_taken(order, clearance)]
+            chunk = max(4096, 4 * n)
+            for lo in range(0, order.size, chunk):
+                cells = np.stack(np.unravel_index(order[lo : lo + chunk], shape), axis=1)
+                pts = self.grid.cell_to_world(cells)
+                ok = self._admissible(pts, clearance, polygon)
+                count = _accept(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
+                if count == n:
+                    return
         raise SamplingError(
-            f"cannot place {what}: found room for {len(chosen)} of {n} with clearance "
+            f"cannot place {what}: found room for {count} of {n} with clearance "
             f"{clearance:g} m from walls, obstacles and forbidden zones "
             f"({flat.size} candidate cells); reduce counts or clearances, or use a larger map"
         )
 
+    def _surely_taken(self, flat: NDArray[np.intp], clearance: float) -> NDArray[np.bool_]:
+        """For flat cell indices: whether the centre is certainly too close to the layers.
+
+        A cell marked by :meth:`_blocked` overlaps an obstacle or forbidden zone, so a centre
+        within ``clearance − res/√2`` (less a margin far above rounding) of such a cell's
+        centre is closer than ``clearance`` to that zone: :meth:`_admissible` rejects it.
+        Dropping those cells first changes nothing but the time a crowded map takes to be
+        searched (most of its candidates lie near some obstacle).
+        """
+        res = self.grid.resolution
+        h, w = self.grid.data.shape
+        scale = abs(clearance) + float(np.abs(self.grid.origin).max()) + res * max(h, w)
+        reach = clearance - res * math.sqrt(0.5) - 1e-9 * scale
+        if reach <= 0:
+            return np.zeros(flat.shape, dtype=bool)
+        # The distance transform of the blocked cells, on the map padded by clear cells so
+        # that its border (which `squared_edt` counts as blocked) is out of reach; kept until
+        # the layers change (a box that does not fit is redrawn many times).
+        pad = math.ceil(reach / res) + 2
+        if self._blocked_edt is None or self._blocked_edt[0] < pad:
+            blocked = self._blocked()
+            if blocked.any():
+                d2 = squared_edt(np.pad(blocked, pad))[pad : pad + h, pad : pad + w]
+                dist = np.sqrt(d2) * res
+            else:
+                dist = np.full((h, w), np.inf)
+            self._blocked_edt = (pad, dist)
+        return self._blocked_edt[1].ravel()[flat] < reach
+
     def _admissible(
         self, pts: FloatArray, clearance: float, polygon: FloatArray | None
     ) -> NDArray[np.bool_]:
-        ok = self.obstacle_distance(pts) >= clearance
+        ok = np.isfinite(pts).all(axis=1)  # what `_accept` bins
+        ok &= self.obstacle_distance(pts, cutoff=clearance) >= clearance
         ok &= self.forbidden_distance(pts) >= clearance
         if polygon is not None:
             ok &= points_in_polygon(pts, polygon)
