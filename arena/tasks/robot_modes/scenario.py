@@ -14,7 +14,7 @@ from arena.core.errors import ConfigError
 from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, SingleGoal, register_mode
 from arena.tasks.episode import RobotSpawn
-from arena.tasks.robot_modes.random import robot_name
+from arena.tasks.robot_modes.random import robot_name, spawn_radius
 from arena.tasks.scenario import Scenario, load_scenario, validate_against_map
 
 
@@ -49,7 +49,7 @@ class ScenarioRobots(SingleGoal):
         file: str = Field(description="path to an Arena scenario JSON file")
         check_map: bool = Field(True, description="reject positions off the map or in walls")
         clearance: float = Field(
-            0.25, ge=0, description="m beyond the robot radius forbidden around start and goal"
+            0.25, ge=0, description="m beyond the robot body forbidden around start and goal"
         )
 
     def __init__(self, params: Params) -> None:
@@ -71,6 +71,6 @@ class ScenarioRobots(SingleGoal):
             entry = sc.robots[k]
             start, goal = Pose2D.from_array(list(entry.start)), Pose2D.from_array(list(entry.goal))
             for p in (start, goal):
-                ctx.sampler.forbid(p.xy, model.radius + self.params.clearance)
+                ctx.sampler.forbid(p.xy, spawn_radius(model) + self.params.clearance)
             spawns.append(RobotSpawn(robot_name(k, n, model.name), model, start, goal))
         return spawns
