@@ -29,7 +29,7 @@ from arena.core.geometry import points_in_polygon
 from arena.maps.grid import OccupancyGrid
 from arena.maps.raster import disk_mask, or_disk, polygon_mask, polygon_window
 from arena.sim.state import Obstacle
-from arena.tasks.sampling import MaskRegions, grid_memo, squared_edt
+from arena.tasks.sampling import MaskRegions, accept_spaced, grid_memo, squared_edt
 
 FloatArray = NDArray[np.float64]
 
@@ -155,81 +155,6 @@ def _minimum(a: float, b: float) -> float:
     if a != a or b != b:
         return np.nan
     return a if a <= b else b
-
-
-@njit(cache=True)
-def _accept(candidates: FloatArray, chosen: FloatArray, count: int, min_gap: float) -> int:
-    """Append to ``chosen[:count]`` each candidate ≥ ``min_gap`` from all chosen so far.
-
-    Candidates are taken in their order; candidate ``m`` is accepted if
-    ``np.hypot(*(p - q)) >= min_gap`` for every chosen ``q`` (the earlier candidates accepted
-    included), until ``chosen`` ``(n, 2)`` holds ``n`` rows; returns the new count. All
-    coordinates must be finite (m).
-
-    Only the pairs that can fail are tested: the points are binned into square buckets of
-    side ``size ≥ min_gap · (1 + 1e-6)``, and points two or more buckets apart (in x or y)
-    differ by more than ``min_gap`` in that coordinate, so their ``hypot`` passes. The
-    outcome is therefore that of testing every pair (the loop this replaced, O(candidates ×
-    chosen), took minutes for 1,000 people), in O(candidates + chosen) for a bounded density.
-    """
-    n = chosen.shape[0]
-    m = candidates.shape[0]
-    if m == 0 or count >= n:
-        return count
-    # Bounding box of everything that can be binned.
-    x0 = y0 = np.inf
-    x1 = y1 = -np.inf
-    for j in range(count):
-        x0, x1 = min(x0, chosen[j, 0]), max(x1, chosen[j, 0])
-        y0, y1 = min(y0, chosen[j, 1]), max(y1, chosen[j, 1])
-    for i in range(m):
-        x0, x1 = min(x0, candidates[i, 0]), max(x1, candidates[i, 0])
-        y0, y1 = min(y0, candidates[i, 1]), max(y1, candidates[i, 1])
-    # Bucket side: a hair above the gap (rounding of the bucket indices), and large enough
-    # that there are at most about 4 buckets per point (memory O(points)).
-    size = min_gap * (1.0 + 1e-6) if min_gap > 0.0 else 1.0
-    cap = 4 * (n + m) + 16
-    while (np.floor((x1 - x0) / size) + 1.0) * (np.floor((y1 - y0) / size) + 1.0) > cap:
-        size *= 2.0
-    nbx = int((x1 - x0) / size) + 1
-    nby = int((y1 - y0) / size) + 1
-    head = np.full(nbx * nby, -1, dtype=np.int64)  # first chosen point of each bucket
-    nxt = np.empty(n, dtype=np.int64)  # the next one in the same bucket
-    for j in range(count):
-        b = _bucket(chosen[j, 0], chosen[j, 1], x0, y0, size, nbx, nby)
-        nxt[j] = head[b]
-        head[b] = j
-    for i in range(m):
-        if count == n:
-            break
-        px = candidates[i, 0]
-        py = candidates[i, 1]
-        b = _bucket(px, py, x0, y0, size, nbx, nby)
-        bx = b % nbx
-        by = b // nbx
-        free = True
-        for yy in range(max(by - 1, 0), min(by + 2, nby)):
-            for xx in range(max(bx - 1, 0), min(bx + 2, nbx)):
-                j = head[yy * nbx + xx]
-                while j >= 0 and free:
-                    if not np.hypot(px - chosen[j, 0], py - chosen[j, 1]) >= min_gap:
-                        free = False
-                    j = nxt[j]
-        if free:
-            chosen[count, 0] = px
-            chosen[count, 1] = py
-            nxt[count] = head[b]
-            head[b] = count
-            count += 1
-    return count
-
-
-@njit(cache=True)
-def _bucket(x: float, y: float, x0: float, y0: float, size: float, nbx: int, nby: int) -> int:
-    """Flat index of the bucket of ``(x, y)`` (clamped: clamping keeps neighbours adjacent)."""
-    bx = min(max(int((x - x0) / size), 0), nbx - 1)
-    by = min(max(int((y - y0) / size), 0), nby - 1)
-    return by * nbx + bx
 
 
 def wall_distance_map(grid: OccupancyGrid) -> FloatArray:
@@ -510,7 +435,7 @@ class WorldSampler:
                 idx = idx[(self._wall.flat[idx] >= wall_min) & ~self._blocked().flat[idx]]
             pts = self._jitter(np.stack(np.unravel_index(idx, shape), axis=1), rng)
             ok = self._admissible(pts, clearance, polygon)
-            count = _accept(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
+            count = accept_spaced(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
         if count < n:
             if flat is None:
                 flat = np.flatnonzero(self.candidate_mask(clearance))
@@ -556,7 +481,7 @@ class WorldSampler:
                 cells = np.stack(np.unravel_index(order[lo : lo + chunk], shape), axis=1)
                 pts = self.grid.cell_to_world(cells)
                 ok = self._admissible(pts, clearance, polygon)
-                count = _accept(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
+                count = accept_spaced(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
                 if count == n:
                     return
         raise SamplingError(
@@ -597,7 +522,7 @@ class WorldSampler:
     def _admissible(
         self, pts: FloatArray, clearance: float, polygon: FloatArray | None
     ) -> NDArray[np.bool_]:
-        ok = np.isfinite(pts).all(axis=1)  # what `_accept` bins
+        ok = np.isfinite(pts).all(axis=1)  # what `accept_spaced` bins
         ok &= self.obstacle_distance(pts, cutoff=clearance) >= clearance
         ok &= self.forbidden_distance(pts) >= clearance
         if polygon is not None:
