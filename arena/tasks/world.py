@@ -517,7 +517,8 @@ class WorldSampler:
             else:
                 dist = np.full((h, w), np.inf)
             self._blocked_edt = (pad, dist)
-        return self._blocked_edt[1].ravel()[flat] < reach
+        taken: NDArray[np.bool_] = self._blocked_edt[1].ravel()[flat] < reach
+        return taken
 
     def _admissible(
         self, pts: FloatArray, clearance: float, polygon: FloatArray | None
