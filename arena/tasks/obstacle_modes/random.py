@@ -227,8 +227,9 @@ def obstacle_capacity(grid: OccupancyGrid, models: Sequence[str], params: Placem
     least ``D = R_min + c + ρ_min`` apart, so the discs of radius ``D/2`` about them are
     disjoint and lie where the wall distance is at least ``R_min + c − D/2``; the area there
     (counted in cells, generously) over ``π D²/4`` bounds the count. Random placement fills
-    well under this (a third to a half): it only turns away requests that can never succeed,
-    without a draw, instead of after minutes of searching.
+    well under this (a quarter to a third of it, e.g. 80 of 311 default boxes on
+    ``small_office``): it only turns away requests that can never succeed, without a draw,
+    instead of after minutes of searching.
     """
     if models:
         shapes = [_box_limits(params) if m == BOX else _model_limits(m) for m in set(models)]
