@@ -48,7 +48,7 @@ from arena.sim.backend import BACKENDS, SimulatorBackend
 from arena.sim.state import SimState
 from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator
-from arena.tasks.robot_modes.random import sample_start_goal
+from arena.tasks.robot_modes.random import sample_start_goal, spawn_radius
 from arena.tasks.world import WorldSampler
 
 FloatArray = NDArray[np.float64]
@@ -614,7 +614,8 @@ class EpisodeDriver:
 
         For multi-robot training (Long et al. 2018): a robot that arrived or collided starts
         over while the others drive on. The start and goal are drawn like ``robots.random``
-        draws them (``radius + clearance`` from walls and obstacles, one connected region,
+        draws them (body radius + clearance from walls and obstacles, the body radius being
+        :func:`~arena.tasks.robot_modes.random.spawn_radius`; one connected region,
         ``min_goal_distance`` apart), also keeping that clearance from where the other robots
         stand and from the people; the robot is teleported there at rest, its laser stack
         filled with its fresh scan, its last action zeroed, its step count restarted and its
@@ -631,9 +632,10 @@ class EpisodeDriver:
         ep = self.episode
         world = WorldSampler(ep.grid, ep.obstacles)  # the map's wall distance is memoised
         poses = self.state.robots.poses
+        body = spawn_radius(self.robot)  # a footprint may reach past `radius` (buddy)
         for j in range(self.n_robots):
             if j != i:
-                world.forbid(poses[j, :2], self.radius)
+                world.forbid(poses[j, :2], body)
         agents = self.state.agents
         for xy, rad in zip(agents.positions, agents.radii, strict=True):
             world.forbid(xy, float(rad))
@@ -641,7 +643,7 @@ class EpisodeDriver:
         self._respawns += 1
         try:
             start, goal = sample_start_goal(
-                world, self.radius + clearance, min_goal_distance, rng, what=f"robot {i} respawn"
+                world, body + clearance, min_goal_distance, rng, what=f"robot {i} respawn"
             )
         except SamplingError:
             return False

@@ -29,7 +29,7 @@ from arena.core.geometry import points_in_polygon
 from arena.maps.grid import OccupancyGrid
 from arena.maps.raster import disk_mask, or_disk, polygon_mask, polygon_window
 from arena.sim.state import Obstacle
-from arena.tasks.sampling import MaskRegions, grid_memo, squared_edt
+from arena.tasks.sampling import MaskRegions, accept_spaced, grid_memo, squared_edt
 
 FloatArray = NDArray[np.float64]
 
@@ -48,26 +48,53 @@ def polygon_distance(points: FloatArray, polygon: FloatArray) -> FloatArray:
     return polygons_distance(points, [polygon])
 
 
-def polygons_distance(points: FloatArray, polygons: Sequence[FloatArray]) -> FloatArray:
+def polygons_distance(
+    points: FloatArray, polygons: Sequence[FloatArray], *, cutoff: float = np.inf
+) -> FloatArray:
     """Distance (m) from ``(n, 2)`` points to the nearest of some filled polygons; ``inf`` if none.
 
     The minimum over ``polygons`` (each ``(k, 2)``, ``k ≥ 1``) of :func:`polygon_distance`.
+    With a finite ``cutoff`` (m), distances below it are still exact (bit for bit), while one
+    of ``cutoff`` or more may come back as any value ``≥ cutoff``: polygons whose bounding box
+    is farther than that are skipped, which is all ``distance >= clearance`` tests need.
     """
-    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    return packed_distance(points, pack_polygons(polygons), cutoff=cutoff)
+
+
+@dataclass(frozen=True, eq=False)
+class PackedPolygons:
+    """Polygons as one array: polygon ``g`` is ``verts[offsets[g]:offsets[g + 1]]`` (m)."""
+
+    verts: FloatArray
+    offsets: NDArray[np.int64]
+
+
+def pack_polygons(polygons: Sequence[FloatArray]) -> PackedPolygons:
+    """Pack ``(k, 2)`` polygons (``k ≥ 1``) for :func:`packed_distance` (callers keep it)."""
     polys = [np.asarray(q, dtype=np.float64) for q in polygons]
-    if not polys:
-        return np.full(len(p), np.inf)
     if any(len(q) == 0 for q in polys):  # the vectorised form's error for an empty polygon
         raise ValueError("zero-size array to reduction operation minimum which has no identity")
-    offsets = np.cumsum([0] + [len(q) for q in polys])
-    verts = np.ascontiguousarray(np.concatenate(polys).reshape(-1, 2))
-    distance: FloatArray = _polygons_distance(p, verts, offsets)
+    offsets = np.cumsum([0] + [len(q) for q in polys]).astype(np.int64)
+    verts = np.concatenate(polys).reshape(-1, 2) if polys else np.zeros((0, 2))
+    return PackedPolygons(np.ascontiguousarray(verts, dtype=np.float64), offsets)
+
+
+def packed_distance(
+    points: FloatArray, polygons: PackedPolygons, *, cutoff: float = np.inf
+) -> FloatArray:
+    """:func:`polygons_distance` of packed polygons."""
+    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 2))
+    if len(polygons.offsets) < 2:
+        return np.full(len(p), np.inf)
+    distance: FloatArray = _polygons_distance(
+        p, polygons.verts, polygons.offsets, float(cutoff)
+    )
     return distance
 
 
 @njit(cache=True, error_model="numpy")
 def _polygons_distance(
-    p: FloatArray, verts: FloatArray, offsets: NDArray[np.int64]
+    p: FloatArray, verts: FloatArray, offsets: NDArray[np.int64], cutoff: float
 ) -> FloatArray:
     """Polygon ``g`` has vertices ``verts[offsets[g]:offsets[g + 1]]``.
 
@@ -77,15 +104,29 @@ def _polygons_distance(
     :func:`~arena.core.geometry.point_segment_distance` (``t`` clipped to [0, 1], NaN → 0;
     ``sqrt(dx² + dy²)``), and NaN propagates through the minima as through ``np.minimum``:
     the same distances, without a dozen numpy temporaries per polygon and batch.
+
+    A point whose gap to a polygon's bounding box, along x or y, exceeds ``cutoff`` (with a
+    relative margin of 1e-9 of the magnitudes involved, far above rounding) skips that
+    polygon: its distance to it is larger still, so the minimum is exact wherever it is
+    below ``cutoff``. NaN coordinates never skip.
     """
     n = p.shape[0]
     out = np.full(n, np.inf)
     for g in range(offsets.shape[0] - 1):
         s = offsets[g]
         k = offsets[g + 1] - s
+        bx0 = bx1 = verts[s, 0]
+        by0 = by1 = verts[s, 1]
+        for e in range(1, k):
+            bx0, bx1 = min(bx0, verts[s + e, 0]), max(bx1, verts[s + e, 0])
+            by0, by1 = min(by0, verts[s + e, 1]), max(by1, verts[s + e, 1])
         for i in range(n):
             px = p[i, 0]
             py = p[i, 1]
+            gap = max(bx0 - px, px - bx1, by0 - py, py - by1)
+            scale = abs(cutoff) + abs(px) + abs(py) + max(abs(bx0), abs(bx1), abs(by0), abs(by1))
+            if gap > cutoff + 1e-9 * scale:
+                continue
             crossings = 0
             best = np.inf
             for e in range(k):
@@ -114,32 +155,6 @@ def _minimum(a: float, b: float) -> float:
     if a != a or b != b:
         return np.nan
     return a if a <= b else b
-
-
-@njit(cache=True)
-def _accept(candidates: FloatArray, chosen: FloatArray, count: int, min_gap: float) -> int:
-    """Append to ``chosen[:count]`` each candidate ≥ ``min_gap`` from all chosen so far.
-
-    ``chosen`` ``(n, 2)`` fills up to ``n`` rows; returns the new count. The test is the one
-    it replaced, ``np.hypot(*(p - q)) >= min_gap`` per pair (the same ``hypot``), in a loop
-    that was a reset's largest Python cost.
-    """
-    n = chosen.shape[0]
-    for m in range(candidates.shape[0]):
-        if count == n:
-            break
-        px = candidates[m, 0]
-        py = candidates[m, 1]
-        free = True
-        for j in range(count):
-            if not np.hypot(px - chosen[j, 0], py - chosen[j, 1]) >= min_gap:
-                free = False
-                break
-        if free:
-            chosen[count, 0] = px
-            chosen[count, 1] = py
-            count += 1
-    return count
 
 
 def wall_distance_map(grid: OccupancyGrid) -> FloatArray:
@@ -177,9 +192,12 @@ class WorldSampler:
         self.grid = grid
         self._wall = wall_distance if wall_distance is not None else wall_distance_map(grid)
         self._polygons: list[FloatArray] = []
+        self._packed: PackedPolygons | None = None  # of _polygons, None once they change
         self._forbidden_discs: list[ForbiddenDisc] = []
         self._forbidden_polygons: list[FloatArray] = []
         self._blocked_cache: NDArray[np.bool_] | None = None
+        # (pad, distance map) of the blocked cells for `_surely_taken`; None once they change.
+        self._blocked_edt: tuple[int, FloatArray] | None = None
         self._free_cache: NDArray[np.intp] | None = None
         self.add_obstacles(obstacles)
 
@@ -188,6 +206,8 @@ class WorldSampler:
         """Add obstacle footprints to the obstacle layer."""
         polys = [np.asarray(o.polygon, dtype=np.float64) for o in obstacles]
         self._polygons.extend(polys)
+        self._packed = None
+        self._blocked_edt = None
         if self._blocked_cache is not None:  # update in place: O(new shapes)
             for poly in polys:
                 self._or_polygon(self._blocked_cache, poly)
@@ -196,6 +216,7 @@ class WorldSampler:
         """Add a forbidden disc (Arena adds every robot start and goal this way)."""
         zone = ForbiddenDisc(float(xy[0]), float(xy[1]), float(radius))
         self._forbidden_discs.append(zone)
+        self._blocked_edt = None
         if self._blocked_cache is not None:
             or_disk(self._blocked_cache, self.grid, zone.x, zone.y, zone.radius)
 
@@ -203,6 +224,7 @@ class WorldSampler:
         """Add a forbidden polygon (m)."""
         poly = np.asarray(polygon, dtype=np.float64)
         self._forbidden_polygons.append(poly)
+        self._blocked_edt = None
         if self._blocked_cache is not None:
             self._or_polygon(self._blocked_cache, poly)
 
@@ -217,6 +239,7 @@ class WorldSampler:
         """Empty the forbidden layer (module ``clear_forbidden_zones``)."""
         self._forbidden_discs.clear()
         self._forbidden_polygons.clear()
+        self._blocked_edt = None
         self._blocked_cache = None
 
     @property
@@ -267,9 +290,14 @@ class WorldSampler:
             out[i] = best
         return out
 
-    def obstacle_distance(self, points: FloatArray) -> FloatArray:
-        """Distance (m) from points to the nearest obstacle footprint (``inf`` if none)."""
-        return polygons_distance(points, self._polygons)
+    def obstacle_distance(self, points: FloatArray, *, cutoff: float = np.inf) -> FloatArray:
+        """Distance (m) from points to the nearest obstacle footprint (``inf`` if none).
+
+        ``cutoff`` as in :func:`polygons_distance`: exact below it.
+        """
+        if self._packed is None:
+            self._packed = pack_polygons(self._polygons)
+        return packed_distance(points, self._packed, cutoff=cutoff)
 
     def forbidden_distance(self, points: FloatArray) -> FloatArray:
         """Distance (m) from points to the nearest forbidden zone (``inf`` if none)."""
@@ -407,14 +435,11 @@ class WorldSampler:
                 idx = idx[(self._wall.flat[idx] >= wall_min) & ~self._blocked().flat[idx]]
             pts = self._jitter(np.stack(np.unravel_index(idx, shape), axis=1), rng)
             ok = self._admissible(pts, clearance, polygon)
-            count = _accept(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
+            count = accept_spaced(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
         if count < n:
             if flat is None:
                 flat = np.flatnonzero(self.candidate_mask(clearance))
-            found = self._exhaustive(
-                flat, shape, n, list(chosen[:count]), clearance, polygon, rng, what
-            )
-            chosen = np.array(found[:n], dtype=np.float64).reshape(n, 2)
+            self._exhaustive(flat, shape, chosen, count, clearance, polygon, rng, what)
         if forbid:
             for p in chosen:
                 self.forbid(p, clearance)
@@ -434,34 +459,72 @@ class WorldSampler:
         self,
         flat: NDArray[np.intp],
         shape: tuple[int, ...],
-        n: int,
-        chosen: list[FloatArray],
+        chosen: FloatArray,
+        count: int,
         clearance: float,
         polygon: FloatArray | None,
         rng: np.random.Generator,
         what: str,
-    ) -> list[FloatArray]:
-        """Last attempt: every candidate cell centre in random order (fails only if none fit)."""
+    ) -> None:
+        """Last attempt: every candidate cell centre in random order (fails only if none fit).
+
+        Fills ``chosen`` ``(n, 2)`` beyond its first ``count`` rows, in place. The candidates
+        are tested in chunks, in that order, up to the one that completes ``chosen``: a
+        request for one position (each placed obstacle) rarely needs more than the first.
+        """
+        n = len(chosen)
         if flat.size:
             order = rng.permutation(flat)
-            cells = np.stack(np.unravel_index(order, shape), axis=1)
-            pts = self.grid.cell_to_world(cells)
-            ok = self._admissible(pts, clearance, polygon)
-            for p in pts[ok]:
-                if all(np.hypot(*(p - q)) >= 2 * clearance for q in chosen):
-                    chosen.append(p)
-                    if len(chosen) == n:
-                        return chosen
+            order = order[~self._surely_taken(order, clearance)]
+            chunk = max(4096, 4 * n)
+            for lo in range(0, order.size, chunk):
+                cells = np.stack(np.unravel_index(order[lo : lo + chunk], shape), axis=1)
+                pts = self.grid.cell_to_world(cells)
+                ok = self._admissible(pts, clearance, polygon)
+                count = accept_spaced(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
+                if count == n:
+                    return
         raise SamplingError(
-            f"cannot place {what}: found room for {len(chosen)} of {n} with clearance "
+            f"cannot place {what}: found room for {count} of {n} with clearance "
             f"{clearance:g} m from walls, obstacles and forbidden zones "
             f"({flat.size} candidate cells); reduce counts or clearances, or use a larger map"
         )
 
+    def _surely_taken(self, flat: NDArray[np.intp], clearance: float) -> NDArray[np.bool_]:
+        """For flat cell indices: whether the centre is certainly too close to the layers.
+
+        A cell marked by :meth:`_blocked` overlaps an obstacle or forbidden zone, so a centre
+        within ``clearance − res/√2`` (less a margin far above rounding) of such a cell's
+        centre is closer than ``clearance`` to that zone: :meth:`_admissible` rejects it.
+        Dropping those cells first changes nothing but the time a crowded map takes to be
+        searched (most of its candidates lie near some obstacle).
+        """
+        res = self.grid.resolution
+        h, w = self.grid.data.shape
+        scale = abs(clearance) + float(np.abs(self.grid.origin).max()) + res * max(h, w)
+        reach = clearance - res * math.sqrt(0.5) - 1e-9 * scale
+        if reach <= 0:
+            return np.zeros(flat.shape, dtype=bool)
+        # The distance transform of the blocked cells, on the map padded by clear cells so
+        # that its border (which `squared_edt` counts as blocked) is out of reach; kept until
+        # the layers change (a box that does not fit is redrawn many times).
+        pad = math.ceil(reach / res) + 2
+        if self._blocked_edt is None or self._blocked_edt[0] < pad:
+            blocked = self._blocked()
+            if blocked.any():
+                d2 = squared_edt(np.pad(blocked, pad))[pad : pad + h, pad : pad + w]
+                dist = np.sqrt(d2) * res
+            else:
+                dist = np.full((h, w), np.inf)
+            self._blocked_edt = (pad, dist)
+        taken: NDArray[np.bool_] = self._blocked_edt[1].ravel()[flat] < reach
+        return taken
+
     def _admissible(
         self, pts: FloatArray, clearance: float, polygon: FloatArray | None
     ) -> NDArray[np.bool_]:
-        ok = self.obstacle_distance(pts) >= clearance
+        ok = np.isfinite(pts).all(axis=1)  # what `accept_spaced` bins
+        ok &= self.obstacle_distance(pts, cutoff=clearance) >= clearance
         ok &= self.forbidden_distance(pts) >= clearance
         if polygon is not None:
             ok &= points_in_polygon(pts, polygon)

@@ -229,7 +229,10 @@ class ParametrizedObstacles:
                 kinds += [entry.kind] * n
             else:
                 prefix = "S" if entry.section == "static" else "I"
-                placed += place_obstacles(ctx, prefix, n, [entry.model], rng, p, counter=names)
+                placed += place_obstacles(
+                    ctx, prefix, n, [entry.model], rng, p, counter=names,
+                    field=f"{self.file}: {entry.where}",
+                )
         agents = place_pedestrians(
             ctx,
             len(kinds),

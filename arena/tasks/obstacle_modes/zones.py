@@ -25,6 +25,7 @@ from pydantic import Field, model_validator
 from arena.sim.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import MAX_PERSON_SPEED, WAYPOINT_LOOP, AgentSpawn, speed_range_problem
+from arena.tasks.robot_modes.random import spawn_radius
 from arena.tasks.zones import ZoneFileParams, ZoneFiles, sample_in_zones
 
 
@@ -66,7 +67,7 @@ class ZoneObstacles:
         world = ctx.sampler
         body = p.agent_radius + 0.05
         for r in ctx.spawns:
-            world.forbid(r.start.xy, r.model.radius + p.agent_robot_clearance)
+            world.forbid(r.start.xy, spawn_radius(r.model) + p.agent_robot_clearance)
         starts: list[np.ndarray] = []
         routes: list[list[np.ndarray]] = []
         kinds: list[int] = []

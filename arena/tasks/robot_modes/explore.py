@@ -18,7 +18,7 @@ from arena.core.errors import SamplingError
 from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import RobotSpawn
-from arena.tasks.robot_modes.random import random_spawns
+from arena.tasks.robot_modes.random import random_spawns, spawn_radius
 from arena.tasks.sampling import components
 from arena.tasks.world import WorldSampler
 
@@ -97,7 +97,7 @@ class ExploreRobots:
             3.0, ge=0, description="m, straight distance from the robot to each new goal"
         )
         clearance: float = Field(
-            0.25, ge=0, description="m kept beyond the robot radius (Arena SPAWN_ROBOT_SAFE_DIST)"
+            0.25, ge=0, description="m kept beyond the robot body (Arena SPAWN_ROBOT_SAFE_DIST)"
         )
         goal_timeout: float | None = Field(
             60.0, gt=0,
@@ -114,7 +114,7 @@ class ExploreRobots:
         return self.params.goal_timeout
 
     def _clearance(self, ctx: ResetContext, robot: int) -> float:
-        return ctx.robots[robot].radius + self.params.clearance
+        return spawn_radius(ctx.robots[robot]) + self.params.clearance
 
     def reset(self, ctx: ResetContext) -> list[RobotSpawn]:
         """Start and goal per robot, as ``robots.random`` draws them."""

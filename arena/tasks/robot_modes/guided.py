@@ -19,7 +19,7 @@ from arena.core.errors import ConfigError
 from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import RobotSpawn
-from arena.tasks.robot_modes.random import robot_name, sample_pose
+from arena.tasks.robot_modes.random import robot_name, sample_pose, spawn_radius
 
 
 @register_mode("robots", "guided", tags=("interactive",))
@@ -38,7 +38,7 @@ class GuidedRobots:
             description="initial shared waypoint list, each [x m, y m, theta rad]",
         )
         clearance: float = Field(
-            0.25, ge=0, description="m kept beyond the robot radius around random starts"
+            0.25, ge=0, description="m kept beyond the robot body around random starts"
         )
 
     def __init__(self, params: Params | None = None) -> None:
@@ -57,7 +57,7 @@ class GuidedRobots:
             self._check(ctx, w, f"task.robots.waypoints[{k}]")
         spawns = []
         for k, model in enumerate(ctx.robots):
-            clearance = model.radius + p.clearance
+            clearance = spawn_radius(model) + p.clearance
             name = robot_name(k, n, model.name)
             if k == 0 and p.start is not None:
                 start = Pose2D(*p.start)

@@ -1,9 +1,10 @@
 """``robots.random``: a random start and goal per robot (Arena specs §2.5).
 
 Unlike Arena (box-filter clearance, garbage positions when the map is full), start and goal
-keep ``robot radius + clearance`` from walls, obstacles and forbidden zones exactly, lie in the
-same connected free region at that clearance (so a path exists for the robot's body), are at
-least ``min_goal_distance`` apart, and become forbidden discs so nothing is placed on them.
+keep ``clearance`` beyond the robot's body (:func:`spawn_radius`: every heading fits) from walls,
+obstacles and forbidden zones exactly, lie in the same connected free region at that clearance
+(so a path exists for the robot's body), are at least ``min_goal_distance`` apart, and become
+forbidden discs so nothing is placed on them.
 """
 
 from __future__ import annotations
@@ -15,9 +16,20 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import SamplingError
 from arena.core.types import Pose2D
+from arena.robots.model import RobotModel
 from arena.tasks.base import ResetContext, SingleGoal, register_mode
 from arena.tasks.episode import RobotSpawn
 from arena.tasks.world import WorldSampler
+
+
+def spawn_radius(model: RobotModel) -> float:
+    """Radius (m) of the disc a start or goal must keep clear for the robot's body.
+
+    The larger of Arena's ``robot_radius`` and the footprint's circumscribed radius: the
+    heading is drawn after the position, so every heading must fit (``buddy``'s radius,
+    0.347 m, plus the 0.25 m clearance fell short of its 0.615 m footprint).
+    """
+    return max(float(model.radius), model.circumscribed_radius)
 
 
 def robot_name(k: int, n: int, model_name: str) -> str:
@@ -100,14 +112,15 @@ def _extent(world: WorldSampler, clearance: float) -> str:
 def random_spawns(
     ctx: ResetContext, min_goal_distance: float, clearance: float
 ) -> list[RobotSpawn]:
-    """A random start and goal for every robot of ``ctx`` (``clearance`` beyond its radius)."""
+    """A random start and goal for every robot of ``ctx`` (``clearance`` beyond its body)."""
     rng = ctx.rng("robots")
     n = len(ctx.robots)
     spawns = []
     for k, model in enumerate(ctx.robots):
         name = robot_name(k, n, model.name)
         start, goal = sample_start_goal(
-            ctx.sampler, model.radius + clearance, min_goal_distance, rng, what=f"robot {name!r}"
+            ctx.sampler, spawn_radius(model) + clearance, min_goal_distance, rng,
+            what=f"robot {name!r}",
         )
         spawns.append(RobotSpawn(name, model, start, goal))
     return spawns
@@ -123,7 +136,7 @@ class RandomRobots(SingleGoal):
         model_config = ConfigDict(frozen=True, extra="forbid")
         min_goal_distance: float = Field(5.0, ge=0, description="m, straight start-goal distance")
         clearance: float = Field(
-            0.25, ge=0, description="m kept beyond the robot radius (Arena SPAWN_ROBOT_SAFE_DIST)"
+            0.25, ge=0, description="m kept beyond the robot body (Arena SPAWN_ROBOT_SAFE_DIST)"
         )
 
     def __init__(self, params: Params | None = None) -> None:

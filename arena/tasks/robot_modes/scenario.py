@@ -14,7 +14,7 @@ from arena.core.errors import ConfigError
 from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, SingleGoal, register_mode
 from arena.tasks.episode import RobotSpawn
-from arena.tasks.robot_modes.random import robot_name
+from arena.tasks.robot_modes.random import robot_name, spawn_radius
 from arena.tasks.scenario import Scenario, load_scenario
 from arena.tasks.scenario_checks import check_layout, check_robot_bodies, validate_against_map
 
@@ -54,7 +54,7 @@ class ScenarioRobots(SingleGoal):
             "robot's footprint overlaps a wall or an obstacle",
         )
         clearance: float = Field(
-            0.25, ge=0, description="m beyond the robot radius forbidden around start and goal"
+            0.25, ge=0, description="m beyond the robot body forbidden around start and goal"
         )
 
     def __init__(self, params: Params) -> None:
@@ -76,7 +76,7 @@ class ScenarioRobots(SingleGoal):
             entry = sc.robots[k]
             start, goal = Pose2D.from_array(list(entry.start)), Pose2D.from_array(list(entry.goal))
             for p in (start, goal):
-                ctx.sampler.forbid(p.xy, model.radius + self.params.clearance)
+                ctx.sampler.forbid(p.xy, spawn_radius(model) + self.params.clearance)
             spawns.append(RobotSpawn(robot_name(k, n, model.name), model, start, goal))
         if self.params.check_map:
             check_layout(sc, goal_radius=ctx.goal_radius, source=self.params.file)

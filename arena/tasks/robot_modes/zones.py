@@ -3,7 +3,7 @@
 Reads the same files as ``obstacles.zones`` (a zones file and a zone scenario, by default the
 world's ``map/zones.yaml`` and ``zones/default.yaml``). Every robot gets a role drawn uniformly
 from the scenario's ``robots`` entries; its start and goal lie inside zones of the role's
-``waypoints in`` categories (a category uniformly, then a zone of it), keep ``robot radius +
+``waypoints in`` categories (a category uniformly, then a zone of it), keep ``robot body +
 clearance`` from walls, obstacles and forbidden zones, are connected at that clearance and at
 least ``min_goal_distance`` apart. Like ``robots.explore`` a robot is never done: on arrival it
 gets a new goal in its role's zones, connected to where it stands when possible.
@@ -19,7 +19,7 @@ from arena.core.errors import ConfigError, SamplingError
 from arena.core.types import Pose2D
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.episode import RobotSpawn
-from arena.tasks.robot_modes.random import robot_name
+from arena.tasks.robot_modes.random import robot_name, spawn_radius
 from arena.tasks.sampling import components
 from arena.tasks.world import WorldSampler
 from arena.tasks.zones import RobotRole, ZoneFileParams, ZoneFiles, ZoneMap, sample_in_zones
@@ -50,7 +50,7 @@ class ZoneRobots:
         """Parameters of ``robots.zones``."""
 
         clearance: float = Field(
-            0.25, ge=0, description="m kept beyond the robot radius (Arena SPAWN_ROBOT_SAFE_DIST)"
+            0.25, ge=0, description="m kept beyond the robot body (Arena SPAWN_ROBOT_SAFE_DIST)"
         )
         min_goal_distance: float = Field(
             2.0, ge=0, description="m, straight distance from the start (or robot) to each goal"
@@ -83,7 +83,7 @@ class ZoneRobots:
         spawns = []
         for k, (model, role) in enumerate(zip(ctx.robots, self.roles(ctx), strict=True)):
             name = robot_name(k, n, model.name)
-            c = model.radius + self.params.clearance
+            c = spawn_radius(model) + self.params.clearance
             start, goal = self._start_goal(ctx.sampler, zones, role, c, rng, f"robot {name!r}")
             spawns.append(RobotSpawn(name, model, start, goal))
         return spawns
@@ -129,7 +129,7 @@ class ZoneRobots:
         """A new goal in the robot's role zones, connected to ``pose`` when possible; never done."""
         zones = self.files.get(ctx.map_spec).zones
         role = self.roles(ctx)[robot]
-        c = ctx.robots[robot].radius + self.params.clearance
+        c = spawn_radius(ctx.robots[robot]) + self.params.clearance
         masks = _masks(ctx.sampler, c, pose, self.params.min_goal_distance)
         if masks[-1] is not None:
             masks.append(None)  # last resort: anywhere in the role's zones
