@@ -527,7 +527,7 @@ def run_name(cfg: ExperimentConfig) -> str:
     robot = Path(cfg.robot).stem if cfg.robot.endswith((".yaml", ".yml")) else cfg.robot
     local = str(cfg.navigation.local_planner.get("type", "planner"))
     # only characters that are safe in a folder name on every system
-    return "_".join(re.sub(r"[^A-Za-z0-9_.-]+", "-", p).strip("-.") or "x"
+    return "_".join(re.sub(r"[^A-Za-z0-9_.-]+", "-", p).strip("-.")[:40] or "x"
                     for p in (where, robot, local))
 
 
