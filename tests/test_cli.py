@@ -2,22 +2,11 @@
 
 import csv
 import json
-import sys
 
 import pytest
 
 from arena import cli
-
-
-def run_cli(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["arena", *args])
-    code = 0
-    try:
-        cli.main()
-    except SystemExit as e:
-        code = e.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
+from tests.cli_kit import run_cli
 
 
 def test_run_writes_trajectory_summary_and_video(monkeypatch, capsys, tmp_path):

@@ -10,8 +10,8 @@ import textwrap
 
 import pytest
 
-from arena import cli
 from arena.core.registry import all_registries
+from tests.cli_kit import run_cli
 
 PLANNER = '''
 """A user's planner: drive straight at the goal at a fixed speed."""
@@ -48,17 +48,6 @@ class Beeline:
         v = self.params.speed * max(math.cos(err), 0.0)
         return limit_command(np.array([v, 0.0, 2.0 * err]), obs.twist, obs.limits, obs.dt)
 '''
-
-
-def run_cli(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["arena", *args])
-    code = 0
-    try:
-        cli.main()
-    except SystemExit as e:
-        code = e.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.fixture

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
@@ -13,17 +12,7 @@ from arena.config import load_config
 from arena.core.errors import ConfigError
 from arena.experiment import default_output_dir, run_name
 from arena.maps.sources import WORLDS_DIR, resolve_scenario
-
-
-def run_cli(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["arena", *args])
-    code = 0
-    try:
-        cli.main()
-    except SystemExit as e:
-        code = e.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
+from tests.cli_kit import run_cli
 
 
 @pytest.mark.parametrize(

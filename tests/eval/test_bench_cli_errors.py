@@ -16,32 +16,11 @@ from arena.core.errors import ArenaError
 from arena.eval.runner import check_scale, run_benchmark
 from arena.eval.store import commit_episode, load_results, read_manifest
 from arena.tasks.suite import load_suite
+from tests.eval._suites import stage
 
-SUITE = """\
-stages:
-  - name: open
-    episodes: 2
-    robot: jackal
-    map: empty_room
-    tm_robots: random
-    tm_obstacles: random
-    timeout: 4
-    config:
-      RANDOM:
-        static: {min: 0, max: 1}
-        dynamic: {min: 1, max: 1}
-  - name: tail
-    episodes: 1
-    robot: burger
-    map: empty_room
-    tm_robots: random
-    tm_obstacles: random
-    timeout: 4
-    config:
-      RANDOM:
-        static: {min: 0, max: 0}
-        dynamic: {min: 1, max: 1}
-"""
+SUITE = "stages:\n" + stage("open", 2, "jackal", timeout=4, static=(0, 1)) + stage(
+    "tail", 1, "burger", timeout=4
+)
 CONTEST = "contestants:\n  - {name: pp, local_planner: pure_pursuit}\n"
 
 

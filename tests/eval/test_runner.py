@@ -23,32 +23,9 @@ from arena.eval.runner import run_benchmark
 from arena.eval.store import commit_episode, completed, load_results, read_manifest, summarize
 from arena.nav.local_planners.base import LOCAL_PLANNERS
 from arena.nav.local_planners.pure_pursuit import PurePursuitPlanner
+from tests.eval._suites import TWO_STAGES
 
-SUITE = """\
-stages:
-  - name: open
-    episodes: 2
-    robot: jackal
-    map: empty_room
-    tm_robots: random
-    tm_obstacles: random
-    timeout: 6
-    config:
-      RANDOM:
-        static: {min: 1, max: 2}
-        dynamic: {min: 1, max: 2}
-  - name: crowd
-    episodes: 2
-    robot: burger
-    map: empty_room
-    tm_robots: random
-    tm_obstacles: random
-    timeout: 6
-    config:
-      RANDOM:
-        static: {min: 0, max: 0}
-        dynamic: {min: 2, max: 2}
-"""
+SUITE = TWO_STAGES
 CONTEST = """\
 contestants:
   - {name: pure_pursuit, local_planner: pure_pursuit}

@@ -27,34 +27,11 @@ from arena.eval import workers
 from arena.eval.runner import run_benchmark
 from arena.eval.store import completed, load_results
 from arena.nav.local_planners.base import LOCAL_PLANNERS
+from tests.eval._suites import TWO_STAGES
 from tests.eval.fault_planners import EXIT_CODE
 
 ROOT = Path(__file__).resolve().parents[2]
-SUITE = """\
-stages:
-  - name: open
-    episodes: 2
-    robot: jackal
-    map: empty_room
-    tm_robots: random
-    tm_obstacles: random
-    timeout: 6
-    config:
-      RANDOM:
-        static: {min: 1, max: 2}
-        dynamic: {min: 1, max: 2}
-  - name: crowd
-    episodes: 2
-    robot: burger
-    map: empty_room
-    tm_robots: random
-    tm_obstacles: random
-    timeout: 6
-    config:
-      RANDOM:
-        static: {min: 0, max: 0}
-        dynamic: {min: 2, max: 2}
-"""
+SUITE = TWO_STAGES
 #: At this scale the suite has one episode per stage.
 SCALE = 0.5
 HEALTHY = "  - {name: pp, local_planner: pure_pursuit}\n"

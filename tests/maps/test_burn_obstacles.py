@@ -3,27 +3,15 @@
 from __future__ import annotations
 
 import json
-import sys
 
 import numpy as np
 
-from arena import cli
 from arena.core.geometry import points_in_polygon
 from arena.maps.grid import OccupancyGrid
 from arena.maps.io import load_map
 from arena.maps.raster import burn_obstacles
 from arena.sim.state import Obstacle
-
-
-def run_cli(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["arena", *args])
-    code = 0
-    try:
-        cli.main()
-    except SystemExit as e:
-        code = e.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
+from tests.cli_kit import run_cli
 
 
 def test_burn_obstacles_marks_exactly_the_covered_cells():
