@@ -49,6 +49,21 @@ def free_road_observation(kinematics: str) -> LocalObservation:
     )
 
 
+def random_twist(rng: np.random.Generator, lim: VelocityLimits, kinematics: str) -> np.ndarray:
+    """A random twist ``(vx, vy, omega)`` (m/s, rad/s) that drive ``kinematics`` can have.
+
+    Inside the box ``lim``; no sideways speed unless holonomic; an ackermann robot drives
+    forward and turns no tighter than its minimum turning radius.
+    """
+    twist = rng.uniform(lim.lower, lim.upper)
+    if not lim.holonomic:
+        twist[1] = 0.0
+    if kinematics == "ackermann":
+        twist[0] = abs(twist[0])
+        twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
+    return twist
+
+
 def random_observations(
     rng: np.random.Generator, kinematics: str, n: int = 20
 ) -> list[LocalObservation]:
@@ -56,12 +71,7 @@ def random_observations(
     lim = STANDARD_LIMITS[kinematics]
     out = []
     for _ in range(n):
-        twist = rng.uniform(lim.lower, lim.upper)
-        if not lim.holonomic:
-            twist[1] = 0.0
-        if kinematics == "ackermann":
-            twist[0] = abs(twist[0])
-            twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
+        twist = random_twist(rng, lim, kinematics)
         pose = rng.uniform([-2, -2, -math.pi], [2, 2, math.pi])
         steps = rng.normal(0, 1.0, (rng.integers(1, 6), 2))
         path = np.vstack([pose[:2], pose[:2] + np.cumsum(steps, axis=0)])

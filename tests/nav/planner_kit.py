@@ -14,6 +14,7 @@ from arena.core.types import Pose2D
 from arena.nav.local_planners import LocalObservation
 from arena.robots.kinematics import integrate_twist
 from arena.robots.limits import VelocityLimits
+from arena.testing.local_planner import random_twist
 
 DT = 0.1
 RADIUS = 0.3
@@ -69,12 +70,7 @@ def random_case(
     rng: np.random.Generator, lim: VelocityLimits, kin: str
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """A random admissible twist, pose, 4-point path and 90-beam scan for drive ``kin``."""
-    twist = rng.uniform(lim.lower, lim.upper)
-    if not lim.holonomic:
-        twist[1] = 0.0
-    if kin == "ackermann":
-        twist[0] = abs(twist[0])
-        twist[2] = twist[0] / lim.min_turning_radius * rng.uniform(-1, 1)
+    twist = random_twist(rng, lim, kin)
     pose = rng.uniform([-1, -1, -3], [1, 1, 3])
     path = np.vstack([pose[:2], pose[:2] + rng.normal(0, 2, (3, 2)).cumsum(axis=0)])
     ranges = rng.uniform(0.4, 5.0, 90)
