@@ -232,6 +232,8 @@ class FrameRenderer:
         # The caller's text replaces the default line, so callers that format time and step
         # themselves (with the outcome appended) do not get them twice.
         self._hud.set_text(ov.text or f"t = {state.time:.2f} s   step {state.step}")
+        # a blank text (a still picture of a world) hides the line and its box
+        self._hud.set_visible(not ov.text or bool(ov.text.strip()))
 
         self._canvas.restore_region(self._background)
         for artist in self._dynamic:

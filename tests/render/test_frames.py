@@ -256,3 +256,14 @@ def test_margin_and_obstacles_outside_map_extend_the_view() -> None:
     assert ymin < -0.49
     assert ymax > 4.49
     assert r.height_px % 2 == 0
+
+
+def test_a_still_picture_of_a_world_has_no_empty_text_box(world: StaticWorld) -> None:
+    """render_world (map previews) shows no time line, so its corner holds no empty box."""
+    from arena.render.frames import render_world
+
+    still = render_world(world, width_px=400, title="preview")
+    corner = still[2:30, 2:30].reshape(-1, 3)
+    assert len(np.unique(corner, axis=0)) == 1  # background only
+    timed = FrameRenderer(world, width_px=400, title="preview").render(_state())
+    assert len(np.unique(timed[2:30, 2:30].reshape(-1, 3), axis=0)) > 1  # the time line's box
