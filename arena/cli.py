@@ -8,14 +8,14 @@ from __future__ import annotations
 
 import os
 import sys
-from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
+from arena.cli_bench import bench, report
+from arena.cli_common import PluginOption, console, err_console, load_plugin_options
 from arena.core.errors import ArenaError, ConfigError
 
 app = typer.Typer(
@@ -24,25 +24,6 @@ app = typer.Typer(
     help="Arena: simulate, develop and benchmark social robot navigation.",
     pretty_exceptions_enable=False,
 )
-console = Console()
-err_console = Console(stderr=True)
-
-PluginOption = Annotated[
-    list[str] | None,
-    typer.Option(
-        "--plugin",
-        help="a plugin .py file or module to import first (it registers itself, e.g. a local "
-        "planner); repeatable; worker processes import it too",
-    ),
-]
-
-
-def _load_plugins(specs: list[str] | None) -> None:
-    """Import the ``--plugin`` files/modules (one-line error naming a bad one)."""
-    if specs:
-        from arena.plugins import load_plugins
-
-        load_plugins(specs)
 
 
 @app.command()
@@ -95,7 +76,7 @@ def run(
     from arena.config import load_config
     from arena.experiment import run_experiment, run_name
 
-    _load_plugins(plugin)
+    load_plugin_options(plugin)
     items = ([config] if config else []) + list(overrides or [])
     path = None
     if items and "=" not in items[0]:
@@ -250,7 +231,7 @@ def plugins(
     """
     from arena.cli_views import print_plugins
 
-    _load_plugins(plugin)
+    load_plugin_options(plugin)
     print_plugins(console, kind, name, as_json=as_json)
 
 
@@ -431,130 +412,7 @@ def tasks_preview(
                       f"{len(contestants) * n} runs: {names}")
 
 
-class BenchBackend(StrEnum):
-    """Where ``arena bench`` runs its episodes."""
-
-    process = "process"
-    ray = "ray"
-
-
-@app.command()
-def bench(
-    suite: Annotated[str, typer.Argument(help="packaged suite name (paper, quick) or YAML path")],
-    contest: Annotated[
-        str | None,
-        typer.Option(
-            help="packaged contest name or YAML path \\[default: basic; resume: the run's]"
-        ),
-    ] = None,
-    workers: Annotated[
-        int, typer.Option("--workers", "-j", help="worker processes (0: in this process, for "
-                          "debugging: no fault isolation); ray: tasks at once")
-    ] = 1,
-    backend: Annotated[
-        BenchBackend,
-        typer.Option(help="process pool, or ray tasks (pip install 'arena\\[ray]'); "
-                          "a run resumes with either"),
-    ] = BenchBackend.process,
-    ray_address: Annotated[
-        str | None,
-        typer.Option(help="ray: connect to this cluster ('auto' or an address) "
-                          "\\[default: start a local Ray with --workers CPUs]"),
-    ] = None,
-    resume: Annotated[
-        Path | None, typer.Option("--resume", help="resume the run in this folder")
-    ] = None,
-    out: Annotated[Path | None, typer.Option("--out", "-o", help="run folder")] = None,
-    scale: Annotated[
-        float | None,
-        typer.Option(
-            help="scale_episodes: factor on every stage \\[default: 1; resume: the run's]"
-        ),
-    ] = None,
-    seed: Annotated[
-        int | None, typer.Option(help="run seed \\[default: 0; resume: the run's]")
-    ] = None,
-    progress: Annotated[
-        bool, typer.Option("--progress/--no-progress", help="show a progress bar")
-    ] = True,
-    report: Annotated[
-        bool, typer.Option("--report/--no-report", help="then write the HTML report (RUN/report)")
-    ] = False,
-    plugin: PluginOption = None,
-    episode_timeout: Annotated[
-        float | None,
-        typer.Option("--episode-timeout", metavar="SECONDS",
-                     help="wall-clock limit of one episode: past it, its worker is killed and "
-                          "the episode ends as error (0: no limit) \\[default: 600]"),
-    ] = None,
-) -> None:
-    """Benchmark: every contestant on every episode of a suite; resumable, parallel.
-
-    Results land in the run folder (``episodes/<contestant>/<stage>/<episode>.parquet|json``,
-    ``run.json``); a killed run continues with ``--resume RUN_DIR``. An episode whose worker
-    dies (a crashing planner) or that runs past ``--episode-timeout`` ends as ``error``; the
-    run goes on.
-    """
-    import math
-    import warnings
-    from datetime import datetime
-
-    from pydantic import ValidationError
-
-    from arena.config.schema import ExperimentConfig
-    from arena.core.errors import ConfigError
-    from arena.eval.runner import run_benchmark
-    from arena.eval.store import load_results, read_manifest
-
-    _load_plugins(plugin)
-    if resume is not None:
-        manifest = read_manifest(resume)  # checked: a bad field is a one-line error
-        contest = contest if contest is not None else str(manifest["contest"])
-        seed = seed if seed is not None else int(manifest["seed"])
-        scale = scale if scale is not None else float(manifest["scale"])
-    contest = contest if contest is not None else "basic"
-    seed = seed if seed is not None else 0
-    scale = scale if scale is not None else 1.0
-    if not (math.isfinite(scale) and scale > 0):
-        raise ArenaError(f"--scale: expected a finite number > 0, got {scale}")
-    if workers < (1 if backend is BenchBackend.ray else 0):
-        raise ArenaError(f"--workers: expected an integer >= "
-                         f"{1 if backend is BenchBackend.ray else 0}, got {workers}")
-    limit = {}  # the runner's default unless given
-    if episode_timeout is not None:
-        if not (math.isfinite(episode_timeout) and episode_timeout >= 0):
-            raise ArenaError(f"--episode-timeout: expected seconds >= 0 (0: no limit), "
-                             f"got {episode_timeout}")
-        if workers == 0 and episode_timeout and backend is BenchBackend.process:
-            raise ArenaError("--episode-timeout: an episode in this process (--workers 0) "
-                             "cannot be stopped; use --workers 1 or more")
-        limit["episode_timeout"] = episode_timeout or None
-    try:
-        base_cfg = ExperimentConfig(seed=seed)
-    except ValidationError as e:  # the schema says what a seed must be
-        raise ConfigError(f"{e.errors()[0]['msg']} (got {seed})", source="--seed") from None
-    if resume is not None and out is not None and resume.resolve() != out.resolve():
-        raise ArenaError("give either --resume RUN_DIR or -o RUN_DIR, not two different folders")
-    if out is not None and out.exists() and not out.is_dir():
-        raise ArenaError(f"-o/--out: {out} is a file; expected a run folder (new or empty)")
-    run_dir = resume or out
-    if run_dir is None:
-        name = Path(contest).stem
-        run_dir = Path("runs") / f"bench_{name}_{datetime.now().strftime('%y-%m-%d_%H-%M-%S')}"
-    with warnings.catch_warnings():
-        # one line per warning (a stage the scale drops ...), not Python's two with a source line
-        warnings.showwarning = lambda message, *args, **kwargs: err_console.print(
-            f"[yellow]warning:[/] {message}", highlight=False, soft_wrap=True)
-        run = run_benchmark(
-            suite, contest, run_dir, base_cfg=base_cfg, workers=workers,
-            resume=resume is not None, scale=scale, progress=progress, backend=backend.value,
-            ray_address=ray_address, **limit,
-        )
-    _print_bench_tables(load_results(run), f"{suite} · {Path(contest).stem} · seed {seed}")
-    console.print(f"run folder: {run}")
-    if report:
-        _write_report(run, None, videos=1, workers=workers)
-
+app.command()(bench)
 
 
 @app.command()
@@ -604,7 +462,7 @@ def train(
     from arena.learn.train_config import TrainSettings
 
     require_sb3()
-    _load_plugins(plugin)
+    load_plugin_options(plugin)
     if export is not None:
         from arena.learn.train import export_checkpoint
 
@@ -643,98 +501,8 @@ def train(
     result = run_training(cfg, settings, run_dir, resume=resume is not None, progress=progress)
     console.print(summary(result))
 
-#: Columns of the per-contestant table ``arena bench`` prints: (metric, header, format).
-_BENCH_COLUMNS = (
-    ("success", "success", "{:.0%}"),  # headers fit an 80-column terminal
-    ("collisions", "coll.\n/ep", "{:.2f}"),
-    ("time_to_goal", "t goal\n(s)", "{:.1f}"),
-    ("path_length", "path\n(m)", "{:.1f}"),
-    ("min_distance_to_person", "min d.\n(m)", "{:.2f}"),
-    ("personal_space_compliance", "pers.\nspace", "{:.0%}"),
-    ("cf_displacement_mean", "cf disp\n(m)", "{:.3f}"),
-)
 
-
-def _print_bench_tables(results: object, title: str) -> None:
-    """Print the per-contestant means (all episodes) and the success rate per stage."""
-    import numpy as np
-
-    from arena.eval import plots
-    from arena.eval.report import summary_table
-
-    cols = plots.as_columns(results)
-    n = len(cols["contestant"])
-    pooled = {**cols, "stage": np.full(n, "all")}
-    names = [m for m, _, _ in _BENCH_COLUMNS if m in cols]
-    means = {(r.contestant, r.metric): r.mean for r in summary_table(pooled, names)}
-    contestants = plots.unique_in_order(cols["contestant"])
-    from rich import box
-
-    table = Table(
-        title=f"arena bench · {title} · mean over all episodes", box=box.SIMPLE_HEAD,
-        caption="min d.: smallest body gap to a person · pers. space: share of steps with "
-        "nobody within 1.2 m · cf disp: how far people were from where they would have "
-        "walked without the robot",
-    )
-    table.add_column("contestant", no_wrap=True)
-    table.add_column("n", justify="right")
-    for m, header, _ in _BENCH_COLUMNS:
-        if m in cols:
-            table.add_column(header, justify="right",
-                             min_width=max(len(line) for line in header.split("\n")))
-    errors = cols["outcome"].astype(str) == "error"
-    for c in contestants:
-        mine = cols["contestant"] == c
-        cells = [c, f"{int(mine.sum())}" + (f" ({int(errors[mine].sum())} err)"
-                                            if errors[mine].any() else "")]
-        for m, _, fmt in _BENCH_COLUMNS:
-            if m in cols:
-                v = means[(c, m)]
-                cells.append(fmt.format(v) if np.isfinite(v) else "–")
-        table.add_row(*cells)
-    console.print(table)
-    stages = plots.unique_in_order(cols["stage"])
-    per_stage = Table(title="success per stage (episodes)", box=box.SIMPLE_HEAD)
-    per_stage.add_column("stage")
-    for c in contestants:
-        per_stage.add_column(c, justify="right")
-    for st in stages:
-        row = [st]
-        for c in contestants:
-            mask = (cols["contestant"] == c) & (cols["stage"] == st)
-            ok = int((cols["outcome"][mask].astype(str) == "success").sum())
-            row.append(f"{ok}/{int(mask.sum())}")
-        per_stage.add_row(*row)
-    console.print(per_stage)
-
-
-def _write_report(run: Path, out: Path | None, *, videos: int, workers: int) -> None:
-    from arena.eval.report import main as write_run_report
-
-    if not (run / "run.json").is_file():
-        raise ConfigError(f"{run}: not a benchmark run folder (no run.json); run arena bench")
-    with console.status("writing the report (figures, videos) ..."):
-        paths = write_run_report(run, out, video_episodes=videos, workers=workers)
-    for kind in ("html", "csv", "tex"):
-        console.print(f"{kind + ':':6} {paths[kind]}")
-
-
-@app.command()
-def report(
-    run: Annotated[Path, typer.Argument(help="a benchmark run folder (from arena bench)")],
-    out: Annotated[
-        Path | None, typer.Option("-o", "--out", help="output folder (default RUN/report)")
-    ] = None,
-    videos: Annotated[
-        int, typer.Option(min=0, help="episodes re-simulated as videos (each for every "
-                          "contestant), picked where the contestants differ most")
-    ] = 1,
-    workers: Annotated[
-        int, typer.Option("--workers", "-j", min=1, help="processes rendering videos")
-    ] = 1,
-) -> None:
-    """Write one self-contained HTML report and CSV/LaTeX tables for a benchmark run."""
-    _write_report(run, out, videos=videos, workers=workers)
+app.command()(report)
 
 
 def main() -> None:
