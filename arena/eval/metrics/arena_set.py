@@ -5,6 +5,9 @@ Differences from Arena's code (see the specs §4.2 and §10), all deliberate:
 * success checks that the goal was actually reached (Arena: "< 3 collisions");
 * pairs and triples are consecutive, never wrapping around to the last samples;
 * path length, curvature and roughness use the 2-D position only (Arena includes the yaw);
+* path lengths leave teleport jumps out (the driven path);
+* normalized curvature and roughness use the path resampled every 0.1 s (``shape_sample_dt``),
+  not the recorded rows, so they do not change with the simulation step;
 * velocity is ``‖(vx, vy)‖`` of the measured twist (Arena takes the norm of the *position*);
 * acceleration and jerk are divided by Δt (Arena: plain differences);
 * roughness uses ``L = |p0 − p2|`` (Arena: wrong axes);
@@ -16,6 +19,7 @@ Differences from Arena's code (see the specs §4.2 and §10), all deliberate:
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -25,6 +29,7 @@ from arena.eval.metrics.base import (
     MetricParams,
     angle_diff,
     any_per_step,
+    driven_segments,
     masked_time,
     metric,
     ped_offsets,
@@ -49,18 +54,22 @@ def reached_goal(record: EpisodeRecord, params: MetricParams) -> bool:
 
 
 def segment_lengths(record: EpisodeRecord) -> FloatArray:
-    """``(T−1,)`` m, 2-D lengths of consecutive position pairs."""
+    """``(T−1,)`` m, 2-D lengths of consecutive position pairs (teleport jumps included)."""
     d = np.diff(record.pose[:, :2], axis=0)
     return np.hypot(d[:, 0], d[:, 1])
 
 
 def _triples(record: EpisodeRecord) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-    """Consecutive 2-D triples.
+    """Consecutive 2-D triples of the recorded rows (see :func:`_point_triples`)."""
+    return _point_triples(record.pose[:, :2])
+
+
+def _point_triples(p: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Consecutive triples of the ``(N, 2)`` m points ``p``.
 
     Twice the triangle area and the sides a=|p0p1|, b=|p1p2|,
-    c=|p0p2| (each ``(T−2,)``, m² and m).
+    c=|p0p2| (each ``(N−2,)``, m² and m; empty for N < 3).
     """
-    p = record.pose[:, :2]
     p0, p1, p2 = p[:-2], p[1:-1], p[2:]
     u, v = p1 - p0, p2 - p0
     area2 = np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
@@ -72,15 +81,53 @@ def _triples(record: EpisodeRecord) -> tuple[FloatArray, FloatArray, FloatArray,
 
 def menger_curvature(record: EpisodeRecord) -> FloatArray:
     """``(T−2,)`` 1/m, ``k = 4·Area / (a·b·c)`` per consecutive triple (0 if a side is 0)."""
-    area2, a, b, c = _triples(record)
-    den = a * b * c
-    ok = den > 0
-    return np.where(ok, 2.0 * area2 / np.where(ok, den, 1.0), 0.0)
+    return _menger(*_triples(record))
 
 
 def path_length_value(record: EpisodeRecord) -> float:
-    """m, sum of consecutive 2-D segment lengths."""
-    return float(np.sum(segment_lengths(record)))
+    """m, sum of the driven 2-D segment lengths.
+
+    Teleport jumps are left out (see :func:`~arena.eval.metrics.base.driven_segments`).
+    """
+    return float(np.sum(segment_lengths(record)[driven_segments(record)]))
+
+
+def _driven_pieces(record: EpisodeRecord) -> list[slice]:
+    """Row slices of the driven stretches between teleport jumps (each ≥ 1 row)."""
+    cuts = np.flatnonzero(~driven_segments(record)) + 1
+    bounds = [0, *cuts.tolist(), record.steps]
+    return [slice(a, b) for a, b in itertools.pairwise(bounds) if b > a]
+
+
+def resampled_triples(
+    record: EpisodeRecord, spacing: float
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Consecutive triples of the path resampled every ``spacing`` s.
+
+    Each driven stretch (rows between teleport jumps) is resampled at ``t_0 + k·spacing``,
+    ``k = 0, 1, …`` up to its last row (a shorter tail is left out), by linear interpolation of
+    the recorded 2-D positions in time; triples never span a jump. Returns twice the triangle
+    areas (m²) and the sides a=|p0p1|, b=|p1p2|, c=|p0p2| (m), each ``(M,)``.
+    """
+    parts: list[tuple[FloatArray, FloatArray, FloatArray, FloatArray]] = []
+    t_all = np.asarray(record.time, dtype=np.float64)
+    for rows in _driven_pieces(record):
+        t, p = t_all[rows], record.pose[rows, :2]
+        n = math.floor((t[-1] - t[0]) / spacing + 1e-9) + 1
+        grid = t[0] + np.arange(n) * spacing
+        q = np.stack([np.interp(grid, t, p[:, 0]), np.interp(grid, t, p[:, 1])], axis=1)
+        parts.append(_point_triples(q))
+    if not parts:
+        return np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0)
+    area2, a, b, c = (np.concatenate(x) for x in zip(*parts, strict=True))
+    return area2, a, b, c
+
+
+def _menger(area2: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> FloatArray:
+    """1/m, ``k = 4·Area / (a·b·c)`` per triple (0 if a side is 0)."""
+    den = a * b * c
+    ok = den > 0
+    return np.where(ok, 2.0 * area2 / np.where(ok, den, 1.0), 0.0)
 
 
 @metric("success", unit="1", description="1 if the episode succeeded and ended inside the goal")
@@ -110,7 +157,10 @@ def time_to_goal(record: EpisodeRecord, params: MetricParams) -> float:
 
 @metric("path_length", unit="m", description="2-D length of the driven path")
 def path_length(record: EpisodeRecord, params: MetricParams) -> float:
-    """m, ``Σ_j ‖p_{j+1} − p_j‖`` over 2-D positions (0 for fewer than 2 rows)."""
+    """m, ``Σ_j ‖p_{j+1} − p_j‖`` over the driven 2-D segments.
+
+    Teleport jumps are left out; 0 for fewer than 2 rows.
+    """
     return path_length_value(record)
 
 
@@ -190,32 +240,41 @@ def curvature_max(record: EpisodeRecord, params: MetricParams) -> float:
 def normalized_curvature(record: EpisodeRecord, params: MetricParams) -> float:
     """Mean curvature times local arc length.
 
-    Dimensionless, mean over triples of ``k · (|p0p1| + |p1p2|)`` (≈ turning angle per
-    triple); NaN with fewer than 3 rows.
+    Dimensionless, on the path resampled every ``shape_sample_dt`` s (default 0.1 s, see
+    :func:`resampled_triples`), so the value does not depend on the simulation step: mean over
+    the resampled triples of ``k · (|p0p1| + |p1p2|)`` with the Menger curvature ``k`` (1/m;
+    ≈ the turning angle in rad over 2·``shape_sample_dt``); NaN with fewer than 3 samples.
     """
-    _, a, b, _ = _triples(record)
-    return safe_mean(menger_curvature(record) * (a + b))
+    area2, a, b, c = resampled_triples(record, params.shape_sample_dt)
+    return safe_mean(_menger(area2, a, b, c) * (a + b))
 
 
 @metric("roughness", unit="1", description="mean 2·Area/L² of consecutive triples")
 def roughness(record: EpisodeRecord, params: MetricParams) -> float:
     """Mean 2·Area/L² of consecutive triples.
 
-    Dimensionless, mean over consecutive triples of ``2·Area / |p0 − p2|²`` (0 where
-    ``p0 = p2``); NaN with fewer than 3 rows.
+    Dimensionless, on the path resampled every ``shape_sample_dt`` s (default 0.1 s, see
+    :func:`resampled_triples`), so the value does not depend on the simulation step: mean over
+    the resampled triples of ``2·Area / |p0 − p2|²`` (Area in m², 0 where ``p0 = p2``); NaN
+    with fewer than 3 samples.
     """
-    area2, _, _, c = _triples(record)
+    area2, _, _, c = resampled_triples(record, params.shape_sample_dt)
     ok = c > 0
     return safe_mean(np.where(ok, area2 / np.where(ok, c * c, 1.0), 0.0))
 
 
 @metric("angle_over_length", unit="rad/m", description="total heading change per metre")
 def angle_over_length(record: EpisodeRecord, params: MetricParams) -> float:
-    """rad/m, ``Σ_j angle_diff(ψ_{j+1}, ψ_j) / path_length``; NaN if the path length is 0."""
+    """Total heading change per metre of the driven path.
+
+    rad/m, ``Σ_j angle_diff(ψ_{j+1}, ψ_j) / path_length`` over the driven segments (teleport
+    jumps left out of both sums); NaN if the path length is 0.
+    """
     length = path_length_value(record)
     if length <= 0:
         return math.nan
-    return float(np.sum(angle_diff(record.pose[1:, 2], record.pose[:-1, 2])) / length)
+    turn = angle_diff(record.pose[1:, 2], record.pose[:-1, 2])
+    return float(np.sum(turn[driven_segments(record)]) / length)
 
 
 @metric("time_in_private_zone", unit="s", description="time a pedestrian was in the private zone")
@@ -265,6 +324,7 @@ __all__ = [
     "menger_curvature",
     "path_length_value",
     "reached_goal",
+    "resampled_triples",
     "segment_lengths",
     "step_dt",
 ]

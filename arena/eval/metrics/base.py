@@ -80,6 +80,10 @@ class MetricParams(BaseModel, frozen=True, extra="forbid"):
     goal_tolerance: float = Field(
         1e-9, ge=0, description="m, float slack added to the goal radius in the success test"
     )
+    shape_sample_dt: float = Field(
+        0.1, gt=0, description="s, time spacing of the path resampled for normalized_curvature "
+        "and roughness (so they do not depend on the simulation step; 0.1 s: Arena's 10 Hz)",
+    )
 
 
 MetricFn = Callable[[EpisodeRecord, MetricParams], float]
@@ -185,6 +189,27 @@ def any_per_step(record: EpisodeRecord, flags: BoolArray) -> BoolArray:
     out = np.zeros(record.steps, dtype=bool)
     out[record.ped_row[flags]] = True
     return out
+
+
+def driven_segments(record: EpisodeRecord) -> BoolArray:
+    """``(T−1,)`` False for the segments ``j → j+1`` that a teleport made, True for driven ones.
+
+    A teleport of robot 0 is the record event ``(t, "teleport", "robot 0 …")``
+    (:func:`arena.experiment.run_episode` and the recorder write it at the time of the row the
+    robot left, before the next step): the segment from the row at time ``t`` to the next row
+    is the jump (it also holds that step's drive, at most ``v_max·Δt``, which is dropped too).
+    """
+    driven = np.ones(max(record.steps - 1, 0), dtype=bool)
+    if driven.size == 0:
+        return driven
+    t = np.asarray(record.time, dtype=np.float64)
+    for when, kind, detail in record.events:
+        if kind != "teleport" or not (detail == "" or detail.startswith("robot 0")):
+            continue
+        j = int(np.argmin(np.abs(t - float(when))))
+        if j < driven.size:
+            driven[j] = False
+    return driven
 
 
 def ped_offsets(record: EpisodeRecord) -> tuple[FloatArray, FloatArray]:
