@@ -1,0 +1,94 @@
+"""Metrics measure the motion, not the sampling: simulation step and teleport jumps."""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from arena.eval.metrics import MetricParams, get_metric
+from tests.eval._records import make_record
+
+
+def m(name, rec, **params):
+    return get_metric(name)(rec, MetricParams(**params))
+
+
+def circle_with_speed_changes(dt, duration=10.0, radius=2.0):
+    """A circle of ``radius`` m driven at ``v(t) = 1 + 0.5·sin t`` m/s, sampled every dt s."""
+    t = np.arange(round(duration / dt) + 1) * dt
+    arc = t + 0.5 * (1.0 - np.cos(t))  # ∫ v dt
+    a = arc / radius
+    pose = np.stack([radius * np.cos(a), radius * np.sin(a), a + np.pi / 2], 1)
+    return make_record(pose, dt=dt)
+
+
+def sine_path(dt, duration=10.0):
+    """``y = 0.5·sin(1.5·x)`` driven with ``x(t) = t + 0.3·sin t`` (speed changes), every dt s."""
+    t = np.arange(round(duration / dt) + 1) * dt
+    x = t + 0.3 * np.sin(t)
+    y = 0.5 * np.sin(1.5 * x)
+    return make_record(np.stack([x, y, np.zeros_like(x)], 1), dt=dt)
+
+
+@pytest.mark.parametrize("name", ["normalized_curvature", "roughness"])
+@pytest.mark.parametrize("motion", [circle_with_speed_changes, sine_path])
+def test_shape_metrics_do_not_depend_on_the_simulation_step(name, motion):
+    ref = m(name, motion(0.1))
+    assert ref > 0.0
+    for dt in (0.05, 0.02, 0.03):  # 0.03: resampled between rows (linear interpolation)
+        assert m(name, motion(dt)) == pytest.approx(ref, rel=0.01), dt
+    # The recorded rows alone would halve the value at dt 0.05 (what the metric used to do).
+    assert m(name, motion(0.05), shape_sample_dt=0.05) < 0.6 * ref
+
+
+def test_shape_metrics_on_a_circle_match_the_hand_computed_value():
+    # Constant 1 m/s on a 2 m circle, resampled every 0.1 s: each resampled triple spans
+    # φ = 0.05 rad per side, its Menger curvature is 1/R, its sides a = b = 2R·sin(φ/2) and
+    # c = 2R·sin φ, so k·(a+b) = 4·sin(φ/2) and 2·Area/c² = a²/(2R·c) = tan(φ/2)/2.
+    radius, phi = 2.0, 0.05
+    for dt in (0.1, 0.05, 0.02):
+        t = np.arange(round(6.0 / dt) + 1) * dt
+        a = t / radius
+        rec = make_record(np.stack([radius * np.cos(a), radius * np.sin(a), a], 1), dt=dt)
+        assert m("normalized_curvature", rec) == pytest.approx(4 * math.sin(phi / 2), rel=1e-9)
+        assert m("roughness", rec) == pytest.approx(math.tan(phi / 2) / 2, rel=1e-9)
+    # A coarser spacing is a different (documented) scale: φ = 0.1 rad per side.
+    assert m("normalized_curvature", rec, shape_sample_dt=0.2) == pytest.approx(
+        4 * math.sin(0.05), rel=1e-9
+    )
+
+
+def teleport_record(with_event=True):
+    """Drive (0,0)→(1,0) turning the yaw 0→0.5 rad in 1 s, be teleported at t = 1 s to
+    (−1, 1) with yaw 1 rad, then drive 2.9 m along +x (rows 11..40, 0.1 s, 1 m/s)."""
+    first = np.stack([np.arange(11) * 0.1, np.zeros(11), np.linspace(0.0, 0.5, 11)], 1)
+    x2 = -0.9 + np.arange(30) * 0.1
+    second = np.stack([x2, np.ones(30), np.ones(30)], 1)
+    rec = make_record(np.concatenate([first, second]), start=[0.0, 0.0, 0.0],
+                      goal=[2.0, 1.0, 0.0], goal_radius=0.05)
+    events = [(1.0, "teleport", "robot 0 to (-1.00, 1.00, 1.00)")] if with_event else []
+    return dataclasses.replace(rec, events=events)
+
+
+def test_teleport_jump_is_not_driven_path():
+    rec = teleport_record()
+    driven = 1.0 + 2.9  # the step after the teleport is dropped with the jump (as EpisodeResult)
+    shortest = math.hypot(2.0, 1.0)
+    assert m("path_length", rec) == pytest.approx(driven)
+    assert m("spl", rec) == pytest.approx(shortest / driven)
+    assert m("path_length_ratio", rec) == pytest.approx(driven / shortest)
+    assert m("angle_over_length", rec) == pytest.approx(0.5 / driven)  # the jump's 0.5 rad too
+    # Both legs are straight: no resampled triple spans the jump.
+    assert m("normalized_curvature", rec) == pytest.approx(0.0, abs=1e-12)
+    assert m("roughness", rec) == pytest.approx(0.0, abs=1e-12)
+    # Without the teleport event the same rows are one path through the jump.
+    plain = teleport_record(with_event=False)
+    assert m("path_length", plain) == pytest.approx(1.0 + math.hypot(1.9, 1.0) + 2.9)
+    assert m("angle_over_length", plain) == pytest.approx(1.0 / m("path_length", plain))
+    assert m("normalized_curvature", plain) > 0.0
+
+
+def test_teleport_of_another_robot_is_driven_path_of_robot_0():
+    rec = dataclasses.replace(teleport_record(), events=[(1.0, "teleport", "robot 1 to (0, 0)")])
+    assert m("path_length", rec) == pytest.approx(m("path_length", teleport_record(False)))
