@@ -70,9 +70,13 @@ def test_pedestrian_in_private_zone_and_compliance():
     peds = [(j, 1, 0.5, 0.4, 0, 0, 0, 0.2) for j in range(11)]
     rec = make_record(rec0.pose, rec0.velocity, peds=peds)
     d = np.hypot(np.arange(11) * 0.1 - 0.5, 0.4)
-    inside = d <= 0.5
-    assert m("time_in_private_zone", rec) == pytest.approx(0.1 * inside.sum())  # rows 2..8, Δt=0.1
-    assert m("time_in_private_zone", rec, private_zone_radius=1.0) == pytest.approx(1.0)
+    # body gap d − 0.2 − 0.2 < 0.15 m: rows 2..8 (d ≤ 0.5), Δt = 0.1; < 0.5 m: rows 1..10
+    inside = d - 0.4 < 0.15
+    assert m("time_in_private_zone", rec, private_zone_radius=0.15) == pytest.approx(
+        0.1 * inside.sum()
+    )
+    assert inside.sum() == 7
+    assert m("time_in_private_zone", rec) == pytest.approx(1.0)
     assert m("personal_space_compliance", rec) == pytest.approx(1 - (d <= 1.2).mean())
     assert m("intimate_space_compliance", rec) == pytest.approx(1 - (d <= 0.45).mean())
     assert m("min_distance_to_person", rec) == pytest.approx(0.4 - 0.4)

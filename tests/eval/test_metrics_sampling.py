@@ -92,3 +92,16 @@ def test_teleport_jump_is_not_driven_path():
 def test_teleport_of_another_robot_is_driven_path_of_robot_0():
     rec = dataclasses.replace(teleport_record(), events=[(1.0, "teleport", "robot 1 to (0, 0)")])
     assert m("path_length", rec) == pytest.approx(m("path_length", teleport_record(False)))
+
+
+def test_private_zone_is_measured_between_bodies():
+    # A jackal (bounding radius 0.267 m) passes a person (0.3 m) at a 0.4 m body gap
+    # (centres 0.967 m apart) for rows 3..7; elsewhere the person is 2 m farther away.
+    centre = 0.267 + 0.3 + 0.4
+    peds = [(j, 1, centre if 3 <= j <= 7 else centre + 2.0, 0.0, 0, 0, 0, 0.3)
+            for j in range(11)]
+    rec = make_record(np.zeros((11, 3)), peds=peds, robot_radius=0.267)
+    assert m("time_in_private_zone", rec) == pytest.approx(0.5)  # gap 0.4 < 0.5 m, 5 rows
+    assert m("time_in_private_zone", rec, private_zone_radius=0.35) == 0.0
+    assert m("time_in_private_zone", rec, private_zone_radius=0.45) == pytest.approx(0.5)
+    assert m("min_distance_to_person", rec) == pytest.approx(0.4)

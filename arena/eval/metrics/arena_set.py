@@ -14,7 +14,8 @@ Differences from Arena's code (see the specs §4.2 and §10), all deliberate:
 * time sums use ``Δt_0 = 0`` (Arena: the first sample's absolute time);
 * "seen by pedestrians" uses the bearing pedestrian→robot = bearing robot→pedestrian + π
   (Arena: π − bearing);
-* the private-zone radius is the paper's 0.5 m (Arena's code: 1.0 m), a parameter.
+* the private zone is a body gap below the paper's 0.5 m (Arena's code: centre distance
+  ≤ 1.0 m), a parameter.
 """
 
 from __future__ import annotations
@@ -281,11 +282,15 @@ def angle_over_length(record: EpisodeRecord, params: MetricParams) -> float:
 def time_in_private_zone(record: EpisodeRecord, params: MetricParams) -> float:
     """Time a pedestrian was in the private zone.
 
-    s, ``Σ Δt_j`` (Δt_0 = 0) over rows where some pedestrian's centre is within
-    ``private_zone_radius`` (default 0.5 m, paper; Arena's code 1.0 m) of the robot's centre.
+    s, ``Σ Δt_j`` (Δt_0 = 0) over rows where the body gap to some pedestrian,
+    ``‖p_ped − p_robot‖ − r_ped − r_robot`` (m, the robot's bounding circle ``meta.robot_radius``
+    and the pedestrian's ``ped_radius``), is below ``private_zone_radius`` (default 0.5 m,
+    paper). A centre distance of 0.5 m would count only collisions: a jackal (0.267 m) and a
+    person (0.3 m) touch at 0.567 m.
     """
     _, dist = ped_offsets(record)
-    return masked_time(record, any_per_step(record, dist <= params.private_zone_radius))
+    gap = dist - record.ped_radius - record.meta.robot_radius
+    return masked_time(record, any_per_step(record, gap < params.private_zone_radius))
 
 
 def _bearing_robot_to_ped(record: EpisodeRecord) -> FloatArray:

@@ -37,8 +37,9 @@ class MetricParams(BaseModel, frozen=True, extra="forbid"):
     private_zone_radius: float = Field(
         0.5,
         gt=0,
-        description="m, centre distance robot-pedestrian counted as 'in the private zone'. "
-        "The Arena 3.0 paper says 0.5 m; Arena's code (PERSONAL_SPACE_RADIUS) uses 1.0 m.",
+        description="m, body gap robot-pedestrian (centre distance less both radii) below "
+        "which a pedestrian is 'in the private zone'. The Arena 3.0 paper says 0.5 m; Arena's "
+        "code (PERSONAL_SPACE_RADIUS) uses 1.0 m centre to centre.",
     )
     robot_gaze_half_angle: float = Field(
         math.radians(5.0), gt=0, description="rad, half-cone of the robot's gaze (Arena: 5°)"
