@@ -9,7 +9,7 @@ stopped (``resume=True`` skips the committed jobs).
 
 Metrics named like a figure of :class:`~arena.experiment.EpisodeResult` (``path_length``,
 ``collisions``) are stored once, as the figure (``collisions`` an int; ``path_length`` without
-teleport jumps); they agree with the metric on episodes without teleports.
+teleport jumps, as the metric, which finds them by the record's ``teleport`` events).
 
 An episode whose planner raises, returns NaN or otherwise fails ends as ``error`` with the
 message in ``error``; the run goes on. Each episode runs in a worker process
