@@ -11,6 +11,7 @@ import pytest
 from arena.config import load_config
 from arena.core.errors import ConfigError
 from arena.core.types import Pose2D
+from arena.eval.metrics import get_metric
 from arena.experiment import run_experiment
 from arena.robots.presets import load_robot
 from arena.tasks.config import TaskConfig
@@ -114,6 +115,10 @@ def test_scripted_episode_goal_teleport_reset(tmp_path):
     after = traj[traj["time"] > 12.05][0]
     assert abs(after["x"] - 2.0) < 0.1 and abs(after["y"] - 2.0) < 0.1
     assert res.path_length < 12.0  # the teleport jump is not driven distance
+    # The record's metric finds the jump by its teleport event: the same driven length.
+    assert get_metric("path_length")(res.record) == pytest.approx(res.path_length, rel=1e-12)
+    jumped = np.sum(np.hypot(*np.diff(res.record.pose[:, :2], axis=0).T))
+    assert jumped > res.path_length + 1.5  # the jump from about (7, 4) to (2, 2)
 
 
 def test_cli_scenario_and_interactive(tmp_path):
