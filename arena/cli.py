@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import os
 import sys
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -325,7 +326,10 @@ def scenario_validate(
     """Check a scenario file (and, with --map, that its positions lie on the map, not in walls)."""
     from arena.tasks.scenario import validate_file
 
-    findings = validate_file(path, map_yaml)
+    with warnings.catch_warnings():
+        # the findings below list what loading warned about (ignored keys ...) once
+        warnings.simplefilter("ignore", UserWarning)
+        findings = validate_file(path, map_yaml)
     for line in findings:
         console.print(f"[yellow]warning:[/] {line}", highlight=False)
     console.print(f"{path}: valid" + (f" ({len(findings)} warning(s))" if findings else ""))
@@ -516,6 +520,10 @@ def main() -> None:
 
     from arena.core.errors import from_validation_error
 
+    # One line per warning (keys an Arena file has that Arena ignores ...), not Python's two
+    # with a source line.
+    warnings.showwarning = lambda message, *args, **kwargs: err_console.print(
+        f"[yellow]warning:[/] {escape(str(message))}", highlight=False, soft_wrap=True)
     try:
         code = app(standalone_mode=False, prog_name="arena")
     except typer.Abort:  # Ctrl-C or end of input at a prompt

@@ -108,6 +108,9 @@ FILES: dict[str, str | bytes] = {
     "malformed.json": '{"robots": [}',
     "toplevel.json": "[1, 2]",
     "unknown.json": '{"robot": []}',
+    # Arena ignores unknown keys (we warn), but one this close to a known key is a typo.
+    "typo.json": _scenario(ped={"vamx": 1.0}),
+    "legacy.json": '{"pedsim_agents": [], "robot_position": [1, 2], "format": "x"}',
     "bad_model.json": _scenario(static=[{"name": "s", "model": "shelv", "pos": [1, 1, 0]}]),
     # robot files
     "robot_dup.yaml": BURGER + "radius: 0.2\n",
@@ -334,7 +337,9 @@ CASES: list[tuple[str, list[str], list[str]]] = [
         ("utf16", ["UTF-16"]),
         ("malformed", ["malformed JSON at line 1"]),
         ("toplevel", ["valid dictionary"]),
-        ("unknown", ["robot", "unknown key"]),
+        ("unknown", ["robot", "unknown key", "did you mean 'robots'"]),
+        ("typo", ["obstacles.dynamic[0].vamx", "did you mean 'vmax'"]),
+        ("legacy", ["none of the keys Arena reads (robots, obstacles)"]),
         ("bad_model", ["obstacles.static[0].model", "shelf"]),
     ]],
     ("scenario_missing", ["run", "--scenario", "{d}/nope.json"], ["--scenario", "nope.json"]),

@@ -184,6 +184,34 @@ def test_scenario_validate(monkeypatch, capsys, tmp_path):
     assert "bad.json" in flat and "obstacles.static[0].model" in flat and "shelf" in flat
 
 
+def test_scenario_validate_names_keys_arena_ignores_once(monkeypatch, capsys, tmp_path):
+    path = tmp_path / "extra.json"
+    ped = {"name": "p", "pos": [3.0, 1.0, 0.0], "waypoints": [[3.0, 4.0, 0.0]],
+           "yaml_file": "person.yaml", "number_of_peds": 1}
+    path.write_text(json.dumps({
+        "robots": [{"start": [1.0, 1.0, 0.0], "goal": [4.0, 4.0, 0.0]}],
+        "obstacles": {"dynamic": [ped]},
+        "format": "arena-rosnav",
+    }))
+    code, out, err = run_cli(monkeypatch, capsys, "scenario", "validate", str(path))
+    assert code == 0, err
+    flat = " ".join(out.split())
+    assert flat.count("keys Arena does not read, ignored: format, number_of_peds, yaml_file") == 1
+    assert flat.endswith("extra.json: valid (1 warning(s))")
+    assert "UserWarning" not in err and "ignored" not in err  # listed once, on stdout
+
+
+def test_warnings_are_one_line(monkeypatch, capsys):
+    import warnings
+
+    monkeypatch.setattr(
+        cli, "app", lambda **kw: warnings.warn("scale 0.1 drops stage 's'", stacklevel=1)
+    )
+    code, _, err = run_cli(monkeypatch, capsys, "run")
+    assert code == 0
+    assert err == "warning: scale 0.1 drops stage 's'\n"
+
+
 def test_tasks_list_and_preview(monkeypatch, capsys):
     code, out, _ = run_cli(monkeypatch, capsys, "tasks", "list")
     assert code == 0

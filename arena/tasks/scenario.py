@@ -6,18 +6,23 @@ The format is Arena-Rosnav's ``worlds/<map>/scenarios/*.json`` (task mode ``scen
      "obstacles": {"static": [...], "interactive": [...], "dynamic": [...]},
      "map": "arena_corridor", "resets": 50}
 
-Which keys are closed and which pass through follows Arena's own loader and the published files:
+Files are read as Arena's loader reads them (it takes each block's keys with ``dict.get``):
 
-* The top level, each robot and the ``obstacles`` block are closed: Arena reads nothing else
-  there, so an unknown key is a spelling mistake and an error. ``map`` and ``resets`` appear in
+* At the top level, in each robot, in the ``obstacles`` block and in each pedestrian
+  (``dynamic``), a key Arena does not read is ignored: published files carry ``format``,
+  ``yaml_file`` and ``number_of_peds``. The ignored keys are named in ONE :class:`UserWarning`
+  per file and in :attr:`Scenario.warnings`. An unknown key close to a known one (``vamx``,
+  ``robot``; see :data:`TYPO_CUTOFF`) stays an error: Arena would silently drop the value the
+  author meant. A file with none of ``robots``/``obstacles`` but other keys (Arena's pre-2023
+  format) is refused, as Arena would load it as an empty task. Typed models stay closed
+  (``extra="forbid"``); only files go through this reading. ``map`` and ``resets`` appear in
   files but Arena's 2024 loader ignores them; they are kept (and written back) as information.
 * Static and interactive obstacles are open: Arena keeps every key beyond ``name``, ``model``
   and ``pos`` as the obstacle's "extra" (pedsim reads ``type``, ``interaction_radius``,
   ``yaml_path``). The three known ones are fields; anything else lands in
   :attr:`ObstacleEntry.extra`, is written back unchanged and is listed in the warnings.
-* Pedestrians (``dynamic``) are closed over the keys Arena's task generator knows (per-ped
-  overrides of the pedsim defaults, see ``Pedestrian``), so a misspelt ``vamx`` is an error
-  instead of a silently ignored override.
+* A pedestrian without ``name`` is named ``dynamic_<i>`` (its index, made unique among the
+  file's names; the name is then written on save), with a warning.
 
 Missing keys default as in Arena: lists are empty, positions are ``[0, 0, 0]``, a pedestrian's
 model is ``actor1``, its ``waypoint_mode`` 0 and its ``type`` adult. Positions and waypoints
@@ -37,13 +42,16 @@ Refused although Arena would load them (no published file has them; each would f
 make no sense): a key given twice, a ``[hi, lo]`` range, a negative parameter, a probability
 above 1, a ``vmax`` outside [0, 3] m/s, a robot goal within the goal radius of its start, two
 pedestrians overlapping at their starts. Against the episode's map the task modes also refuse a
+robot start or goal off the map or on an unknown (-1) cell, and a
 robot whose real footprint overlaps a wall or an obstacle at its start or goal (``check_map:
 false`` turns the map checks off). Both are in :mod:`arena.tasks.scenario_checks`.
 """
 
 from __future__ import annotations
 
+import difflib
 import json
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -54,6 +62,7 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    PrivateAttr,
     Strict,
     StrictInt,
     StrictStr,
@@ -269,11 +278,21 @@ class Scenario(BaseModel):
     obstacles: Obstacles = Field(default_factory=Obstacles)
     map: StrictStr | None = Field(None, description="informational; the launch arg picks the map")
     resets: StrictInt | None = Field(None, ge=0, description="informational; not read by Arena")
+    # Set by parse_scenario: what reading the file as Arena does changed (generated names,
+    # ignored keys), one line each; not part of the value (equality, saving).
+    _read_notes: tuple[str, ...] = PrivateAttr(default=())
+
+    def __eq__(self, other: object) -> bool:
+        # The fields only: how a file was read (the notes) does not change what it describes.
+        return type(other) is type(self) and self.__dict__ == other.__dict__
+
+    def __hash__(self) -> int:  # frozen: hashable, consistent with __eq__
+        return hash(tuple(self.__dict__.values()))
 
     @property
     def warnings(self) -> tuple[str, ...]:
         """Quirks accepted on load, one readable line each (key path first)."""
-        out: list[str] = []
+        out: list[str] = list(self._read_notes)
         for i, r in enumerate(self.robots):
             for key in ("start", "goal"):
                 if key not in r.model_fields_set:
@@ -311,6 +330,102 @@ class Scenario(BaseModel):
 
 
 # -- reading and writing ------------------------------------------------------------------------
+TYPO_CUTOFF = 0.75
+"""difflib similarity from which an unknown key counts as a misspelt known one (``vamx`` →
+``vmax`` is 0.75, ``robot`` → ``robots`` 0.91; the extra keys of Arena's files stay below 0.6)."""
+
+# The blocks Arena reads with ``dict.get``: an unknown key there is ignored by Arena.
+_BLOCK_FIELDS: dict[str, frozenset[str]] = {
+    "top": frozenset(Scenario.model_fields),
+    "robot": frozenset(RobotEntry.model_fields),
+    "obstacles": frozenset(Obstacles.model_fields),
+    "dynamic": frozenset(Pedestrian.model_fields),
+}
+
+
+def _drop_unknown(
+    block: dict[str, Any], kind: str, path: str, ignored: list[str], source: str | None
+) -> dict[str, Any]:
+    """``block`` without the keys Arena does not read, their paths appended to ``ignored``.
+
+    Raises:
+        ConfigError: an unknown key one edit or so from a known one (a spelling mistake that
+            would silently drop a value the author meant).
+    """
+    known = _BLOCK_FIELDS[kind]
+    out: dict[str, Any] = {}
+    for key, value in block.items():
+        if key in known:
+            out[key] = value
+            continue
+        where = f"{path}.{key}" if path else key
+        close = difflib.get_close_matches(key, sorted(known), n=1, cutoff=TYPO_CUTOFF)
+        if close:
+            raise ConfigError(
+                f"unknown key; did you mean {close[0]!r}? (Arena would ignore it silently)",
+                source=source, path=where,
+            )
+        ignored.append(where)
+    return out
+
+
+def _read_as_arena(data: Any, source: str | None) -> tuple[Any, list[str]]:
+    """The file's JSON as Arena's loader sees it, and a note for each thing it changed.
+
+    Arena reads every block with ``dict.get``: keys it does not know are ignored (the notes and
+    one :class:`UserWarning` per file name them), and a pedestrian without ``name`` gets one
+    (``dynamic_<i>``, made unique among the file's names). Anything of the wrong type is left
+    for validation to report.
+    """
+    if not isinstance(data, dict):
+        return data, []
+    ignored: list[str] = []
+    notes: list[str] = []
+    out = _drop_unknown(data, "top", "", ignored, source)
+    robots = out.get("robots")
+    if isinstance(robots, list):
+        out["robots"] = [
+            _drop_unknown(r, "robot", f"robots[{i}]", ignored, source) if isinstance(r, dict) else r
+            for i, r in enumerate(robots)
+        ]
+    obstacles = out.get("obstacles")
+    if isinstance(obstacles, dict):
+        obstacles = _drop_unknown(obstacles, "obstacles", "obstacles", ignored, source)
+        peds = obstacles.get("dynamic")
+        if isinstance(peds, list):
+            taken = {p["name"] for p in peds
+                     if isinstance(p, dict) and isinstance(p.get("name"), str)}
+            fixed: list[Any] = []
+            for i, p in enumerate(peds):
+                if isinstance(p, dict):
+                    where = f"obstacles.dynamic[{i}]"
+                    p = _drop_unknown(p, "dynamic", where, ignored, source)
+                    if "name" not in p:
+                        p["name"] = _unique(f"dynamic_{i}", taken)
+                        notes.append(f"{where}.name: missing, named {p['name']!r} (as Arena does)")
+                fixed.append(p)
+            obstacles["dynamic"] = fixed
+        out["obstacles"] = obstacles
+    if ignored and not {"robots", "obstacles"} & out.keys():
+        # Nothing Arena reads: a legacy format (pedsim_agents, robot_position ...), which Arena's
+        # loader would turn into an empty task; say so instead of loading nothing.
+        raise ConfigError(
+            f"none of the keys Arena reads (robots, obstacles) is present, only "
+            f"{', '.join(sorted(ignored))}: not a scenario file of Arena's format (an older "
+            "format Arena no longer reads?)",
+            source=source,
+        )
+    if ignored:
+        keys = ", ".join(sorted({w.rsplit(".", 1)[-1] for w in ignored}))
+        line = (
+            f"keys Arena does not read, ignored: {keys} ({len(ignored)} place(s), first "
+            f"{ignored[0]})"
+        )
+        notes.insert(0, line)
+        warnings.warn(f"{source or 'scenario'}: {line}", UserWarning, stacklevel=3)
+    return out, notes
+
+
 def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
     """Parse and validate scenario JSON text.
 
@@ -326,11 +441,12 @@ def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
             or two pedestrians on one spot (see
             :func:`~arena.tasks.scenario_checks.check_layout`).
     """
-    data = files.parse_json(text, source=source)
+    data, notes = _read_as_arena(files.parse_json(text, source=source), source)
     try:
         scenario = Scenario.model_validate(data)
     except ValidationError as e:
         raise from_validation_error(e, source=source) from None
+    scenario._read_notes = tuple(notes)
     for group in ("static", "interactive"):
         for i, o in enumerate(getattr(scenario.obstacles, group)):
             try:

@@ -1,7 +1,8 @@
 """Checks of a scenario that go beyond its format: layout, and positions against a map.
 
 :func:`check_layout` refuses what no map can make valid (start == goal, two people on one
-spot); :func:`validate_against_map` checks every position lies on the map and out of walls;
+spot); :func:`validate_against_map` checks every position lies on the map and out of walls (and
+robot starts and goals out of unknown space);
 :func:`check_robot_bodies` checks each robot's real footprint at its start and goal against the
 walls and placed obstacles with the simulator's own contact tests.
 """
@@ -18,28 +19,33 @@ from arena.sim.state import Obstacle
 from arena.tasks.episode import RobotSpawn
 from arena.tasks.scenario import DEFAULT_PED_RADIUS, Scenario
 
+_ROBOT, _PERSON, _OBSTACLE = "robot", "person", "obstacle"
 
-def _points(scenario: Scenario) -> list[tuple[str, Sequence[float], bool]]:
-    """Every position of the scenario as (key path, xy, must be free of walls)."""
-    pts: list[tuple[str, Sequence[float], bool]] = []
+
+def _points(scenario: Scenario) -> list[tuple[str, Sequence[float], str]]:
+    """Every position of the scenario as (key path, xy, what stands there)."""
+    pts: list[tuple[str, Sequence[float], str]] = []
     for i, r in enumerate(scenario.robots):
-        pts += [(f"robots[{i}].start", r.start, True), (f"robots[{i}].goal", r.goal, True)]
+        pts += [(f"robots[{i}].start", r.start, _ROBOT), (f"robots[{i}].goal", r.goal, _ROBOT)]
     for group in ("static", "interactive"):
         for i, o in enumerate(getattr(scenario.obstacles, group)):
-            # An obstacle may stand against (or partly in) a wall: only its being on the map
-            # is checked.
-            pts.append((f"obstacles.{group}[{i}].pos", o.pos, False))
+            pts.append((f"obstacles.{group}[{i}].pos", o.pos, _OBSTACLE))
     for i, p in enumerate(scenario.obstacles.dynamic):
-        pts.append((f"obstacles.dynamic[{i}].pos", p.pos, True))
+        pts.append((f"obstacles.dynamic[{i}].pos", p.pos, _PERSON))
         for j, w in enumerate(p.waypoints):
-            pts.append((f"obstacles.dynamic[{i}].waypoints[{j}]", w, True))
+            pts.append((f"obstacles.dynamic[{i}].waypoints[{j}]", w, _PERSON))
     return pts
 
 
 def validate_against_map(
     scenario: Scenario, grid: OccupancyGrid, *, source: str | None = None
 ) -> list[str]:
-    """Check that every position lies on ``grid`` and robots/pedestrians are not in walls.
+    """Check that every position lies on ``grid``, robots/pedestrians not in walls.
+
+    A robot's start and goal must also lie in known space: an unknown (-1) cell is outside the
+    mapped building (the simulator may drive through unknown space unless
+    ``unknown_is_occupied``, but a task placed there is a mistake). An obstacle may stand
+    against (or partly in) a wall: only its being on the map is checked.
 
     Args:
         scenario: the scenario.
@@ -55,7 +61,7 @@ def validate_against_map(
     """
     xmin, ymin, xmax, ymax = grid.bounds
     problems: list[tuple[str, str]] = []
-    for path, pos, must_be_free in _points(scenario):
+    for path, pos, what in _points(scenario):
         xy = np.array([float(pos[0]), float(pos[1])])
         where = f"({xy[0]:g}, {xy[1]:g})"
         if not bool(grid.contains(xy)):
@@ -66,8 +72,13 @@ def validate_against_map(
                     f"y in [{ymin:g}, {ymax:g}])",
                 )
             )
-        elif must_be_free and bool(grid.is_occupied(xy)):
+        elif what != _OBSTACLE and bool(grid.is_occupied(xy)):
             problems.append((path, f"{where} lies inside a wall of the map"))
+        elif what == _ROBOT and int(grid.data[tuple(grid.world_to_cell(xy))]) < 0:
+            problems.append(
+                (path, f"{where} lies in unknown space of the map (cell -1, outside the "
+                       "mapped area); a robot needs a known free start and goal")
+            )
     if problems:
         # The first problem leads (file and key path first); the rest are listed after it.
         (path, text), rest = problems[0], problems[1:]

@@ -224,6 +224,74 @@ def test_static_extras_and_legacy_model_names_pass_through(tmp_path: Path) -> No
     assert json.loads((tmp_path / "out.json").read_text()) == data
 
 
+def test_pedestrian_without_name_gets_a_generated_unique_one(tmp_path: Path) -> None:
+    # As in an Arena 2023 file (old/Eval_13_02.json): dynamic obstacles with no name.
+    data = {
+        "robots": [{"start": [1.0, 1.0, 0.0], "goal": [5.0, 5.0, 0.0]}],
+        "obstacles": {
+            "dynamic": [
+                {"type": "pedestrian", "pos": [2.0, 2.0, 0.0], "waypoints": [[3.0, 3.0, 0.0]]},
+                {"name": "dynamic_2", "pos": [4.0, 4.0, 0.0]},
+                {"pos": [6.0, 6.0, 0.0]},
+            ]
+        },
+    }
+    s = load_scenario(write(tmp_path, data))
+    assert [p.name for p in s.obstacles.dynamic] == ["dynamic_0", "dynamic_2", "dynamic_2_2"]
+    assert s.obstacles.dynamic[0].waypoints == ((3.0, 3.0, 0.0),)
+    assert "obstacles.dynamic[0].name: missing, named 'dynamic_0' (as Arena does)" in s.warnings
+    assert not any("dynamic[1].name" in w for w in s.warnings)
+
+
+@pytest.mark.parametrize(
+    ("patch", "keys", "first"),
+    [
+        (lambda d: d.update(format="arena-rosnav"), "format", "format"),
+        (
+            lambda d: d["obstacles"]["dynamic"][1].update(yaml_file="/home/x/person.model.yaml"),
+            "yaml_file",
+            "obstacles.dynamic[1].yaml_file",
+        ),
+        (
+            lambda d: [p.update(number_of_peds=1) for p in d["obstacles"]["dynamic"]],
+            "number_of_peds",
+            "obstacles.dynamic[0].number_of_peds",
+        ),
+        (  # all three, as in arena-rosnav@working_dir's scenario1.json: still ONE warning
+            lambda d: (
+                d.update(format="x"),
+                [p.update(yaml_file="p.yaml", number_of_peds=1) for p in d["obstacles"]["dynamic"]],
+            ),
+            "format, number_of_peds, yaml_file",
+            "format",
+        ),
+    ],
+)
+def test_keys_arena_ignores_are_ignored_with_one_warning(
+    tmp_path: Path, patch: Any, keys: str, first: str
+) -> None:
+    data = json.loads(json.dumps(DEFAULT_JSON))
+    patch(data)
+    path = write(tmp_path, data, "extra.json")
+    with pytest.warns(UserWarning, match="keys Arena does not read") as record:
+        s = load_scenario(path)
+    assert len(record) == 1
+    text = str(record[0].message)
+    assert text.startswith(f"{path}: keys Arena does not read, ignored: {keys} (")
+    assert f"first {first})" in text
+    assert s.warnings[0] == text.removeprefix(f"{path}: ")
+    # Everything Arena reads is read as without the extra keys.
+    assert s == parse_scenario(json.dumps(DEFAULT_JSON))
+
+
+def test_a_file_with_no_key_arena_reads_is_refused(tmp_path: Path) -> None:
+    # Arena's pre-2023 format (evaluation_floor/scenarios/obs10.json): Arena 3 reads nothing.
+    legacy = {"pedsim_agents": [], "robot_position": [1, 2], "robot_goal": [3, 4], "format": "x"}
+    with pytest.raises(ConfigError, match=r"legacy\.json: none of the keys Arena reads "
+                       r"\(robots, obstacles\) is present, only format, pedsim_agents"):
+        load_scenario(write(tmp_path, legacy, "legacy.json"))
+
+
 # -- errors -------------------------------------------------------------------------------------
 def test_malformed_json_names_file_line_and_column(tmp_path: Path) -> None:
     path = write(tmp_path, '{\n  "robots": [\n    {"start": [1, 2, 3],,}\n  ]\n}', "bad.json")
@@ -296,6 +364,25 @@ def test_robot_start_inside_a_wall(grid: OccupancyGrid) -> None:
         validate_against_map(s, grid, source="s.json")
 
 
+@pytest.mark.parametrize("key", ["start", "goal"])
+def test_robot_in_unknown_space_is_refused(grid: OccupancyGrid, key: str) -> None:
+    # Like ignc's default.json: a start outside the building, where the map is unknown (-1).
+    data = grid.data.copy()
+    data[100:150, 0:50] = -1  # x 0-5 m, y 10-15 m unknown
+    g = OccupancyGrid(data, grid.resolution, grid.origin)
+    sc = json.loads(json.dumps(DEFAULT_JSON))
+    sc["robots"][0][key] = [2.5, 12.5, 0.0]
+    sc["obstacles"]["dynamic"][0]["waypoints"][0] = [2.0, 12.0, 0.0]  # people may walk there
+    with pytest.raises(ConfigError) as e:
+        validate_against_map(parse_scenario(json.dumps(sc)), g, source="s.json")
+    msg = str(e.value)
+    assert msg == (
+        f"s.json: robots[0].{key}: (2.5, 12.5) lies in unknown space of the map (cell -1, "
+        "outside the mapped area); a robot needs a known free start and goal"
+    )
+    assert validate_against_map(parse_scenario(json.dumps(DEFAULT_JSON)), g) == []
+
+
 def test_valid_scenario_passes_the_map_check(grid: OccupancyGrid) -> None:
     for data in (DEFAULT_JSON, CORRIDOR_JSON, HOSPITAL_JSON):
         assert validate_against_map(parse_scenario(json.dumps(data)), grid) == []
@@ -317,6 +404,22 @@ def test_validate_file_with_a_map_yaml(tmp_path: Path) -> None:
     path = write(tmp_path, DEFAULT_JSON)
     with pytest.raises(ConfigError, match=r"robots\[0\]\.start: \(24, 20\) lies outside the map"):
         validate_file(path, str(tmp_path / "map.yaml"))
+
+
+def test_validate_file_refuses_a_start_in_unknown_space_of_a_map_yaml(tmp_path: Path) -> None:
+    # 10 m × 10 m at 0.5 m: the left half unknown (PGM 205, ROS map_server's "unknown" grey).
+    row = bytes([205]) * 10 + bytes([254]) * 10
+    (tmp_path / "map.pgm").write_bytes(b"P5\n20 20\n255\n" + row * 20)
+    (tmp_path / "map.yaml").write_text(
+        "image: map.pgm\nresolution: 0.5\norigin: [0.0, 0.0, 0.0]\nnegate: 0\n"
+        "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    inside = {"robots": [{"start": [6.0, 5.0, 0.0], "goal": [9.0, 5.0, 0.0]}]}
+    assert validate_file(write(tmp_path, inside, "in.json"), str(tmp_path / "map.yaml")) == []
+    outside = {"robots": [{"start": [2.0, 5.0, 0.0], "goal": [9.0, 5.0, 0.0]}]}
+    with pytest.raises(ConfigError, match=r"out\.json: robots\[0\]\.start: \(2, 5\) lies in "
+                       r"unknown space"):
+        validate_file(write(tmp_path, outside, "out.json"), str(tmp_path / "map.yaml"))
 
 
 # -- episode ------------------------------------------------------------------------------------
