@@ -193,6 +193,7 @@ def test_scenario_validate_names_keys_arena_ignores_once(monkeypatch, capsys, tm
         "obstacles": {"dynamic": [ped]},
         "format": "arena-rosnav",
     }))
+    monkeypatch.setattr(cli.console, "width", 1000)  # a long tmp path is not wrapped mid-name
     code, out, err = run_cli(monkeypatch, capsys, "scenario", "validate", str(path))
     assert code == 0, err
     flat = " ".join(out.split())

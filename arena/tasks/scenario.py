@@ -38,10 +38,12 @@ instead of an error, so that every file Arena ships loads unchanged:
 * Legacy model names ending in ``.yaml`` (``shelf.yaml``) name the library model ``shelf``.
 * An unknown pedestrian ``type`` is treated as adult (what Arena's crowd model does).
 
-Refused although Arena would load them (no published file has them; each would fail late or
-make no sense): a key given twice, a ``[hi, lo]`` range, a negative parameter, a probability
-above 1, a ``vmax`` outside [0, 3] m/s, a robot goal within the goal radius of its start, two
-pedestrians overlapping at their starts. Against the episode's map the task modes also refuse a
+Refused although Arena would load them (each would fail late or make no sense): a key given
+twice, a ``[hi, lo]`` range, a negative parameter, a probability above 1, a ``vmax`` outside
+[0, 3] m/s, a robot goal within the goal radius of its start, two pedestrians on one spot (closer
+than 1 cm: Arena's map7 ``default.json`` has such a pair). Pedestrians whose bodies merely
+overlap (Arena's floor, hospital and map_empty_medium worlds place some 0.5 m apart) load with a
+warning. Against the episode's map the task modes also refuse a
 robot start or goal off the map or on an unknown (-1) cell, and a
 robot whose real footprint overlaps a wall or an obstacle at its start or goal (``check_map:
 false`` turns the map checks off). Both are in :mod:`arena.tasks.scenario_checks`.

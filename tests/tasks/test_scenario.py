@@ -527,3 +527,23 @@ def test_model_not_in_library_at_conversion_lists_known_models(grid: OccupancyGr
     msg = str(e.value)
     assert msg.startswith("obstacles.interactive[0].model: unknown obstacle model 'forklift'")
     assert "known: " in msg and "shelf" in msg
+
+
+def test_people_with_overlapping_bodies_load_with_a_warning_one_spot_is_refused():
+    """Arena's worlds place people 0.5 m apart (bodies of 0.3 m overlap): they load, with a
+    warning; two people within 1 cm of each other are one spot and refused."""
+    def scenario(second_x: float) -> str:
+        return json.dumps({
+            "robots": [{"start": [1.0, 1.0, 0.0], "goal": [8.0, 1.0, 0.0]}],
+            "obstacles": {"static": [], "interactive": [], "dynamic": [
+                {"name": "a", "pos": [5.0, 5.0, 0.0], "waypoints": [[6.0, 5.0, 0.0]]},
+                {"name": "b", "pos": [second_x, 5.0, 0.0], "waypoints": [[6.0, 6.0, 0.0]]},
+            ]},
+        })
+
+    with pytest.warns(UserWarning, match=r"close\.json: obstacles\.dynamic\[1\] starts 0\.5 m "
+                                          r"from obstacles\.dynamic\[0\]: 1 pair"):
+        sc = parse_scenario(scenario(5.5), source="close.json")
+    assert [p.pos[0] for p in sc.obstacles.dynamic] == [5.0, 5.5]
+    with pytest.raises(ConfigError, match=r"dynamic\[1\]\.pos.*two people on one spot"):
+        parse_scenario(scenario(5.005), source="same.json")
