@@ -105,3 +105,26 @@ def test_private_zone_is_measured_between_bodies():
     assert m("time_in_private_zone", rec, private_zone_radius=0.35) == 0.0
     assert m("time_in_private_zone", rec, private_zone_radius=0.45) == pytest.approx(0.5)
     assert m("min_distance_to_person", rec) == pytest.approx(0.4)
+
+
+def _jackal_passes_person(gap_near, gap_far=3.0):
+    """A jackal (0.267 m) and a person (0.3 m): body gap ``gap_near`` at rows 3..7, else far."""
+    peds = [(j, 1, 0.567 + (gap_near if 3 <= j <= 7 else gap_far), 0.0, 0, 0, 0, 0.3)
+            for j in range(11)]
+    return make_record(np.zeros((11, 3)), peds=peds, robot_radius=0.267)
+
+
+def test_personal_and_intimate_space_are_measured_between_bodies():
+    # gap 1.0 m (centres 1.567 m apart): inside Hall's 1.2 m personal space for 5 of 11 rows,
+    # outside Francis's 0.5 m and the 0.45 m intimate space; centre to centre it would be outside
+    rec = _jackal_passes_person(1.0)
+    assert m("personal_space_compliance", rec) == pytest.approx(6 / 11)
+    assert m("personal_space_compliance", rec, personal_space_radius=0.5) == 1.0
+    assert m("intimate_space_compliance", rec) == 1.0
+    # gap 0.4 m (centres 0.967 m): inside the intimate space for the same 5 rows
+    rec = _jackal_passes_person(0.4)
+    assert m("intimate_space_compliance", rec) == pytest.approx(6 / 11)
+    assert m("intimate_space_compliance", rec, intimate_space_radius=0.35) == 1.0
+    assert m("personal_space_compliance", rec, personal_space_radius=0.5) == pytest.approx(6 / 11)
+    assert m("min_distance_to_person", rec) == pytest.approx(0.4)
+    assert m("personal_space_compliance", make_record(np.zeros((11, 3)))) == 1.0

@@ -48,10 +48,13 @@ class MetricParams(BaseModel, frozen=True, extra="forbid"):
         math.radians(5.0), gt=0, description="rad, half-cone of a pedestrian's gaze (Arena: 5°)"
     )
     personal_space_radius: float = Field(
-        1.2, gt=0, description="m, Hall (1966) personal distance, close phase (centre distance)"
+        1.2, gt=0, description="m, body gap robot-pedestrian (centre distance less both radii) "
+        "below which a pedestrian is in the personal space: Hall (1966) personal distance, close "
+        "phase; Francis et al. (2023) use 0.5 m",
     )
     intimate_space_radius: float = Field(
-        0.45, gt=0, description="m, Hall (1966) intimate distance (centre distance)"
+        0.45, gt=0, description="m, body gap robot-pedestrian below which a pedestrian is in the "
+        "intimate space: Hall (1966) intimate distance",
     )
     group_distance: float = Field(
         1.5, gt=0, description="m, pedestrians closer than this are linked into one group"

@@ -1,7 +1,8 @@
 """Social-navigation metrics after Francis et al. (2023), Guzzi et al. (2013) and Helbing (1995).
 
-Radii (centre distances unless said otherwise): personal space 1.2 m and intimate space 0.45 m
-(Hall 1966, close phases); groups link pedestrians closer than 1.5 m. All are
+Personal space 1.2 m and intimate space 0.45 m (Hall 1966, close phases; Francis et al. 2023 use
+0.5 m for personal space) are body gaps, the centre distance less both radii; groups link
+pedestrians whose centres are closer than 1.5 m. All are
 :class:`~arena.eval.metrics.base.MetricParams` fields.
 """
 
@@ -174,25 +175,32 @@ def _compliance(record: EpisodeRecord, radius: float) -> float:
     if record.steps == 0:
         return math.nan
     _, dist = ped_offsets(record)
-    return 1.0 - float(np.mean(any_per_step(record, dist <= radius)))
+    gap = dist - record.ped_radius - record.meta.robot_radius
+    return 1.0 - float(np.mean(any_per_step(record, gap < radius)))
 
 
-@metric("personal_space_compliance", unit="1", description="share of steps nobody within 1.2 m")
+@metric("personal_space_compliance", unit="1",
+        description="share of steps with no body gap to a person below the personal radius")
 def personal_space_compliance(record: EpisodeRecord, params: MetricParams) -> float:
-    """Share of steps nobody within 1.2 m.
+    """Share of steps with no body gap to a person below the personal radius.
 
-    Dimensionless, fraction of rows with no pedestrian centre within
-    ``personal_space_radius`` (1.2 m, Hall 1966) of the robot centre; NaN without rows.
+    Dimensionless, fraction of rows where every pedestrian's body gap
+    ``‖p_ped − p_robot‖ − r_ped − r_robot`` (m, the robot's bounding circle
+    ``meta.robot_radius``, the pedestrian's ``ped_radius``) is at least
+    ``personal_space_radius`` (default 1.2 m, Hall 1966; Francis et al. 2023: 0.5 m); 1.0
+    without pedestrians, NaN without rows.
     """
     return _compliance(record, params.personal_space_radius)
 
 
-@metric("intimate_space_compliance", unit="1", description="share of steps nobody within 0.45 m")
+@metric("intimate_space_compliance", unit="1",
+        description="share of steps with no body gap to a person below the intimate radius")
 def intimate_space_compliance(record: EpisodeRecord, params: MetricParams) -> float:
-    """Share of steps nobody within 0.45 m.
+    """Share of steps with no body gap to a person below the intimate radius.
 
-    Dimensionless, fraction of rows with no pedestrian centre within
-    ``intimate_space_radius`` (0.45 m, Hall 1966) of the robot centre; NaN without rows.
+    Dimensionless, fraction of rows where every pedestrian's body gap
+    ``‖p_ped − p_robot‖ − r_ped − r_robot`` (m) is at least ``intimate_space_radius``
+    (default 0.45 m, Hall 1966); 1.0 without pedestrians, NaN without rows.
     """
     return _compliance(record, params.intimate_space_radius)
 
