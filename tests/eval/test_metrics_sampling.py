@@ -128,3 +128,24 @@ def test_personal_and_intimate_space_are_measured_between_bodies():
     assert m("personal_space_compliance", rec, personal_space_radius=0.5) == pytest.approx(6 / 11)
     assert m("min_distance_to_person", rec) == pytest.approx(0.4)
     assert m("personal_space_compliance", make_record(np.zeros((11, 3)))) == 1.0
+
+
+def _with_contacts(rows):
+    coll = np.zeros(11, bool)
+    coll[list(rows)] = True
+    pose = np.stack([np.arange(11) * 0.1, np.zeros(11), np.zeros(11)], axis=1)
+    return make_record(pose, collision=coll)
+
+
+def test_success_rule_goal_ignores_collisions_arena_needs_fewer_than_two():
+    one, two = _with_contacts([2, 3]), _with_contacts([2, 5, 6])  # 1 and 2 rising edges
+    assert (m("collisions", one), m("collisions", two)) == (1.0, 2.0)
+    assert m("success", two) == 1.0  # default "goal": reaching the goal is enough
+    assert m("success", one, success_rule="arena") == 1.0
+    assert m("success", two, success_rule="arena") == 0.0
+    assert m("spl", two, success_rule="arena") == 0.0
+    assert m("spl", two) == pytest.approx(1.0)
+    missed = dataclasses.replace(one, meta=dataclasses.replace(one.meta, outcome="timeout"))
+    assert m("success", missed, success_rule="arena") == 0.0
+    with pytest.raises(ValueError, match="success_rule"):
+        MetricParams(success_rule="paper")

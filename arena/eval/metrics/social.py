@@ -17,7 +17,7 @@ from arena.eval.metrics.arena_set import (
     goal_distance,
     jerk_values,
     path_length_value,
-    reached_goal,
+    succeeded,
 )
 from arena.eval.metrics.base import (
     FloatArray,
@@ -80,11 +80,12 @@ def stalled_time(record: EpisodeRecord, params: MetricParams) -> float:
 def spl(record: EpisodeRecord, params: MetricParams) -> float:
     """Success weighted by (shortest / actual) path length.
 
-    Dimensionless, ``S · ℓ / max(p, ℓ)``: S success (0/1), ℓ the shortest path length
+    Dimensionless, ``S · ℓ / max(p, ℓ)``: S the ``success`` metric (0/1, under
+    ``success_rule``), ℓ the shortest path length
     (``shortest_path`` or the straight line start→goal), p the driven 2-D path length; 1.0 for a
     success with ``ℓ = p = 0``.
     """
-    if not reached_goal(record, params):
+    if not succeeded(record, params):
         return 0.0
     ell, p = shortest_length(record, params), path_length_value(record)
     return 1.0 if max(ell, p) <= 0 else ell / max(ell, p)
