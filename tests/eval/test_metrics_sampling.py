@@ -149,3 +149,32 @@ def test_success_rule_goal_ignores_collisions_arena_needs_fewer_than_two():
     assert m("success", missed, success_rule="arena") == 0.0
     with pytest.raises(ValueError, match="success_rule"):
         MetricParams(success_rule="paper")
+
+
+def test_minimum_acceleration_jerk_curvature_and_heading_change_by_hand():
+    # Along +x with speeds 0, 0.1, 0.3, 0.6, 1.0 m/s at dt 0.1: a = 1, 2, 3, 4 m/s²,
+    # jerk = 10 m/s³ throughout; positions a straight line (curvature 0 everywhere).
+    v = np.array([0.0, 0.1, 0.3, 0.6, 1.0])
+    x = np.concatenate([[0.0], np.cumsum(v[1:] * 0.1)])
+    rec = make_record(np.stack([x, 0 * x, 0 * x], axis=1),
+                      velocity=np.stack([v, 0 * v, 0 * v], axis=1))
+    assert m("acceleration_min", rec) == pytest.approx(1.0)
+    assert m("acceleration_max", rec) == pytest.approx(4.0)
+    assert m("jerk_min", rec) == pytest.approx(10.0)
+    assert m("curvature_min", rec) == 0.0
+    assert m("heading_change", rec) == 0.0
+    # A square of side 1 driven corner to corner: triples at the corners have curvature
+    # 4·0.5/(1·1·√2) = √2 1/m; each step the yaw changes by 90° (3π/2 → 0 too)
+    pose = [(0, 0, 0), (1, 0, np.pi / 2), (1, 1, 0), (2, 1, 1.5 * np.pi), (2, 2, 0)]
+    rec = make_record(pose)
+    assert m("curvature_min", rec) == pytest.approx(math.sqrt(2))
+    assert m("heading_change", rec) == pytest.approx(4 * np.pi / 2)
+    assert math.isnan(m("jerk_min", make_record(np.zeros((2, 3)))))
+    assert math.isnan(m("acceleration_min", make_record(np.zeros((1, 3)))))
+    assert math.isnan(m("curvature_min", make_record(np.zeros((2, 3)))))
+
+
+def test_heading_change_leaves_teleport_jumps_out():
+    # the first leg turns 0 → 0.5 rad; the jump's 0.5 → 1 rad counts only without the event
+    assert m("heading_change", teleport_record()) == pytest.approx(0.5)
+    assert m("heading_change", teleport_record(False)) == pytest.approx(1.0)

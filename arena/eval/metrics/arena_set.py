@@ -294,10 +294,13 @@ def angle_over_length(record: EpisodeRecord, params: MetricParams) -> float:
     jumps left out of both sums); NaN if the path length is 0.
     """
     length = path_length_value(record)
-    if length <= 0:
-        return math.nan
+    return heading_change_value(record) / length if length > 0 else math.nan
+
+
+def heading_change_value(record: EpisodeRecord) -> float:
+    """rad, ``Σ_j angle_diff(ψ_{j+1}, ψ_j)`` over the driven segments (teleport jumps left out)."""
     turn = angle_diff(record.pose[1:, 2], record.pose[:-1, 2])
-    return float(np.sum(turn[driven_segments(record)]) / length)
+    return float(np.sum(turn[driven_segments(record)]))
 
 
 @metric("time_in_private_zone", unit="s", description="time a pedestrian was in the private zone")
@@ -348,6 +351,7 @@ __all__ = [
     "acceleration_values",
     "count_contacts",
     "goal_distance",
+    "heading_change_value",
     "jerk_values",
     "menger_curvature",
     "path_length_value",

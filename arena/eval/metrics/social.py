@@ -15,7 +15,9 @@ import numpy as np
 from arena.eval.metrics.arena_set import (
     acceleration_values,
     goal_distance,
+    heading_change_value,
     jerk_values,
+    menger_curvature,
     path_length_value,
     succeeded,
 )
@@ -124,6 +126,49 @@ def jerk_max(record: EpisodeRecord, params: MetricParams) -> float:
     """m/s³, maximum of the jerk magnitudes (see ``jerk``); NaN with fewer than 3 rows."""
     j = jerk_values(record)
     return float(np.max(j)) if j.size else math.nan
+
+
+@metric("acceleration_min", unit="m/s^2", description="smallest acceleration magnitude")
+def acceleration_min(record: EpisodeRecord, params: MetricParams) -> float:
+    """Smallest acceleration magnitude (Francis et al. 2023, A_min).
+
+    m/s², ``min ‖Δv‖/Δt`` over consecutive pairs of rows (world-frame velocity vectors, the
+    values ``acceleration`` and ``acceleration_max`` use); NaN with fewer than 2 rows.
+    """
+    a = acceleration_values(record)
+    return float(np.min(a)) if a.size else math.nan
+
+
+@metric("jerk_min", unit="m/s^3", description="smallest jerk magnitude")
+def jerk_min(record: EpisodeRecord, params: MetricParams) -> float:
+    """Smallest jerk magnitude (Francis et al. 2023, J_min).
+
+    m/s³, minimum of the jerk magnitudes per consecutive triple of rows (the values ``jerk``
+    and ``jerk_max`` use); NaN with fewer than 3 rows.
+    """
+    j = jerk_values(record)
+    return float(np.min(j)) if j.size else math.nan
+
+
+@metric("curvature_min", unit="1/m", description="smallest Menger curvature of the path")
+def curvature_min(record: EpisodeRecord, params: MetricParams) -> float:
+    """Smallest Menger curvature of the path (Arena 3.0 paper).
+
+    1/m, minimum over consecutive 2-D triples of rows of ``4·Area/(|p0p1|·|p1p2|·|p0p2|)``
+    (0 for a degenerate triple, as ``curvature`` and ``curvature_max``); NaN with < 3 rows.
+    """
+    k = menger_curvature(record)
+    return float(np.min(k)) if k.size else math.nan
+
+
+@metric("heading_change", unit="rad", description="cumulative heading change over the path")
+def heading_change(record: EpisodeRecord, params: MetricParams) -> float:
+    """Cumulative heading change over the driven path (Francis et al. 2023).
+
+    rad, ``Σ_j angle_diff(ψ_{j+1}, ψ_j)`` (each step's yaw change in ``[0, π]``) over the
+    driven segments, teleport jumps left out; 0 with fewer than 2 rows.
+    """
+    return heading_change_value(record)
 
 
 @metric("min_distance_to_person", unit="m", description="smallest body gap robot-pedestrian")
