@@ -178,3 +178,17 @@ def test_heading_change_leaves_teleport_jumps_out():
     # the first leg turns 0 → 0.5 rad; the jump's 0.5 → 1 rad counts only without the event
     assert m("heading_change", teleport_record()) == pytest.approx(0.5)
     assert m("heading_change", teleport_record(False)) == pytest.approx(1.0)
+
+
+def test_collisions_by_kind():
+    rec = _with_contacts([2, 3, 4, 8])  # wall contact at rows 2..4 and 8
+    obstacle, ped, robot = (np.zeros(11, bool) for _ in range(3))
+    obstacle[[4, 5]] = True  # from the wall onto an adjoining obstacle: the same collision
+    ped[[1, 6, 7, 9]] = True  # rows 1, 6..7, 9: three contacts
+    robot[5] = True
+    rec = dataclasses.replace(rec, collision_obstacle=obstacle, collision_pedestrian=ped,
+                              collision_robot=robot)
+    assert m("collisions_static", rec) == 2.0
+    assert m("collisions_pedestrian", rec) == 3.0
+    assert m("collisions_robot", rec) == 1.0
+    assert m("collisions", rec) == 1.0  # contact of any kind from row 1 to row 9 without a break

@@ -170,6 +170,28 @@ def collisions(record: EpisodeRecord, params: MetricParams) -> float:
     return float(count_contacts(record.collision))
 
 
+@metric("collisions_static", unit="-", description="collisions with walls and obstacles")
+def collisions_static(record: EpisodeRecord, params: MetricParams) -> float:
+    """Collisions with walls and obstacles.
+
+    Rising edges (as ``collisions``) of ``collision_wall | collision_obstacle``: a contact that
+    moves from a wall onto an adjoining obstacle is one collision.
+    """
+    return float(count_contacts(record.collision_wall | record.collision_obstacle))
+
+
+@metric("collisions_pedestrian", unit="-", description="collisions with pedestrians")
+def collisions_pedestrian(record: EpisodeRecord, params: MetricParams) -> float:
+    """Rising edges (as ``collisions``) of ``collision_pedestrian`` (any pedestrian)."""
+    return float(count_contacts(record.collision_pedestrian))
+
+
+@metric("collisions_robot", unit="-", description="collisions with other robots")
+def collisions_robot(record: EpisodeRecord, params: MetricParams) -> float:
+    """Rising edges (as ``collisions``) of ``collision_robot`` (any other robot)."""
+    return float(count_contacts(record.collision_robot))
+
+
 @metric("time_to_goal", unit="s", description="time from reset to reaching the goal")
 def time_to_goal(record: EpisodeRecord, params: MetricParams) -> float:
     """s, ``t_T − t_0`` for a successful episode (see ``success``); NaN otherwise."""
