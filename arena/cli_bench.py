@@ -168,11 +168,15 @@ def _print_bench_tables(results: object, title: str) -> None:
     contestants = plots.unique_in_order(cols["contestant"])
     from rich import box
 
+    from arena.eval.metrics import MetricParams
+
+    # the radius the metrics were computed with (the runner uses the default parameters)
+    radius = MetricParams().personal_space_radius
     table = Table(
         title=f"arena bench · {title} · mean over all episodes", box=box.SIMPLE_HEAD,
         caption="min d.: smallest body gap to a person · pers. space: share of steps with "
-        "nobody within 1.2 m · cf disp: how far people were from where they would have "
-        "walked without the robot",
+        f"no body gap to a person below {radius:g} m · cf disp: how far people were from where "
+        "they would have walked without the robot",
     )
     table.add_column("contestant", no_wrap=True)
     table.add_column("n", justify="right")

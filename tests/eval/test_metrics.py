@@ -77,8 +77,8 @@ def test_pedestrian_in_private_zone_and_compliance():
     )
     assert inside.sum() == 7
     assert m("time_in_private_zone", rec) == pytest.approx(1.0)
-    assert m("personal_space_compliance", rec) == pytest.approx(1 - (d <= 1.2).mean())
-    assert m("intimate_space_compliance", rec) == pytest.approx(1 - (d <= 0.45).mean())
+    assert m("personal_space_compliance", rec) == pytest.approx(1 - (d - 0.4 < 1.2).mean())
+    assert m("intimate_space_compliance", rec) == pytest.approx(1 - (d - 0.4 < 0.45).mean())
     assert m("min_distance_to_person", rec) == pytest.approx(0.4 - 0.4)
     assert m("time_in_private_zone", rec0) == 0.0
 

@@ -105,3 +105,90 @@ def test_private_zone_is_measured_between_bodies():
     assert m("time_in_private_zone", rec, private_zone_radius=0.35) == 0.0
     assert m("time_in_private_zone", rec, private_zone_radius=0.45) == pytest.approx(0.5)
     assert m("min_distance_to_person", rec) == pytest.approx(0.4)
+
+
+def _jackal_passes_person(gap_near, gap_far=3.0):
+    """A jackal (0.267 m) and a person (0.3 m): body gap ``gap_near`` at rows 3..7, else far."""
+    peds = [(j, 1, 0.567 + (gap_near if 3 <= j <= 7 else gap_far), 0.0, 0, 0, 0, 0.3)
+            for j in range(11)]
+    return make_record(np.zeros((11, 3)), peds=peds, robot_radius=0.267)
+
+
+def test_personal_and_intimate_space_are_measured_between_bodies():
+    # gap 1.0 m (centres 1.567 m apart): inside Hall's 1.2 m personal space for 5 of 11 rows,
+    # outside Francis's 0.5 m and the 0.45 m intimate space; centre to centre it would be outside
+    rec = _jackal_passes_person(1.0)
+    assert m("personal_space_compliance", rec) == pytest.approx(6 / 11)
+    assert m("personal_space_compliance", rec, personal_space_radius=0.5) == 1.0
+    assert m("intimate_space_compliance", rec) == 1.0
+    # gap 0.4 m (centres 0.967 m): inside the intimate space for the same 5 rows
+    rec = _jackal_passes_person(0.4)
+    assert m("intimate_space_compliance", rec) == pytest.approx(6 / 11)
+    assert m("intimate_space_compliance", rec, intimate_space_radius=0.35) == 1.0
+    assert m("personal_space_compliance", rec, personal_space_radius=0.5) == pytest.approx(6 / 11)
+    assert m("min_distance_to_person", rec) == pytest.approx(0.4)
+    assert m("personal_space_compliance", make_record(np.zeros((11, 3)))) == 1.0
+
+
+def _with_contacts(rows):
+    coll = np.zeros(11, bool)
+    coll[list(rows)] = True
+    pose = np.stack([np.arange(11) * 0.1, np.zeros(11), np.zeros(11)], axis=1)
+    return make_record(pose, collision=coll)
+
+
+def test_success_rule_goal_ignores_collisions_arena_needs_fewer_than_two():
+    one, two = _with_contacts([2, 3]), _with_contacts([2, 5, 6])  # 1 and 2 rising edges
+    assert (m("collisions", one), m("collisions", two)) == (1.0, 2.0)
+    assert m("success", two) == 1.0  # default "goal": reaching the goal is enough
+    assert m("success", one, success_rule="arena") == 1.0
+    assert m("success", two, success_rule="arena") == 0.0
+    assert m("spl", two, success_rule="arena") == 0.0
+    assert m("spl", two) == pytest.approx(1.0)
+    missed = dataclasses.replace(one, meta=dataclasses.replace(one.meta, outcome="timeout"))
+    assert m("success", missed, success_rule="arena") == 0.0
+    with pytest.raises(ValueError, match="success_rule"):
+        MetricParams(success_rule="paper")
+
+
+def test_minimum_acceleration_jerk_curvature_and_heading_change_by_hand():
+    # Along +x with speeds 0, 0.1, 0.3, 0.6, 1.0 m/s at dt 0.1: a = 1, 2, 3, 4 m/s²,
+    # jerk = 10 m/s³ throughout; positions a straight line (curvature 0 everywhere).
+    v = np.array([0.0, 0.1, 0.3, 0.6, 1.0])
+    x = np.concatenate([[0.0], np.cumsum(v[1:] * 0.1)])
+    rec = make_record(np.stack([x, 0 * x, 0 * x], axis=1),
+                      velocity=np.stack([v, 0 * v, 0 * v], axis=1))
+    assert m("acceleration_min", rec) == pytest.approx(1.0)
+    assert m("acceleration_max", rec) == pytest.approx(4.0)
+    assert m("jerk_min", rec) == pytest.approx(10.0)
+    assert m("curvature_min", rec) == 0.0
+    assert m("heading_change", rec) == 0.0
+    # A square of side 1 driven corner to corner: triples at the corners have curvature
+    # 4·0.5/(1·1·√2) = √2 1/m; each step the yaw changes by 90° (3π/2 → 0 too)
+    pose = [(0, 0, 0), (1, 0, np.pi / 2), (1, 1, 0), (2, 1, 1.5 * np.pi), (2, 2, 0)]
+    rec = make_record(pose)
+    assert m("curvature_min", rec) == pytest.approx(math.sqrt(2))
+    assert m("heading_change", rec) == pytest.approx(4 * np.pi / 2)
+    assert math.isnan(m("jerk_min", make_record(np.zeros((2, 3)))))
+    assert math.isnan(m("acceleration_min", make_record(np.zeros((1, 3)))))
+    assert math.isnan(m("curvature_min", make_record(np.zeros((2, 3)))))
+
+
+def test_heading_change_leaves_teleport_jumps_out():
+    # the first leg turns 0 → 0.5 rad; the jump's 0.5 → 1 rad counts only without the event
+    assert m("heading_change", teleport_record()) == pytest.approx(0.5)
+    assert m("heading_change", teleport_record(False)) == pytest.approx(1.0)
+
+
+def test_collisions_by_kind():
+    rec = _with_contacts([2, 3, 4, 8])  # wall contact at rows 2..4 and 8
+    obstacle, ped, robot = (np.zeros(11, bool) for _ in range(3))
+    obstacle[[4, 5]] = True  # from the wall onto an adjoining obstacle: the same collision
+    ped[[1, 6, 7, 9]] = True  # rows 1, 6..7, 9: three contacts
+    robot[5] = True
+    rec = dataclasses.replace(rec, collision_obstacle=obstacle, collision_pedestrian=ped,
+                              collision_robot=robot)
+    assert m("collisions_static", rec) == 2.0
+    assert m("collisions_pedestrian", rec) == 3.0
+    assert m("collisions_robot", rec) == 1.0
+    assert m("collisions", rec) == 1.0  # contact of any kind from row 1 to row 9 without a break

@@ -254,6 +254,8 @@ def test_cli_bench(files: tuple[Path, Path], tmp_path: Path, monkeypatch: pytest
     assert code == 0, err
     assert "pure_pursuit" in out and "dwa" in out and "crowd" in out
     assert "mean over all episodes" in out and "success per stage" in out
+    # the caption names the personal-space radius the metrics used (MetricParams' default)
+    assert "no body gap to a person below 1.2 m" in " ".join(out.split())
     assert f"run folder: {run}" in out.replace("\n", "")
     assert f"html:  {run / 'report' / 'report.html'}" in out
     assert (run / "report" / "report.html").is_file()

@@ -26,6 +26,7 @@ import math
 import numpy as np
 
 from arena.eval.metrics.base import (
+    BoolArray,
     FloatArray,
     MetricParams,
     angle_diff,
@@ -131,21 +132,64 @@ def _menger(area2: FloatArray, a: FloatArray, b: FloatArray, c: FloatArray) -> F
     return np.where(ok, 2.0 * area2 / np.where(ok, den, 1.0), 0.0)
 
 
+def count_contacts(contact: BoolArray) -> int:
+    """Rising edges of a ``(T,)`` contact flag; the state before row 0 counts as no contact."""
+    c = contact.astype(np.int8)
+    return int(np.count_nonzero(np.diff(c, prepend=np.int8(0)) > 0))
+
+
+def succeeded(record: EpisodeRecord, params: MetricParams) -> bool:
+    """Success under ``params.success_rule``.
+
+    "goal": :func:`reached_goal`; "arena": that and fewer than 2 collisions (the paper's rule).
+    """
+    if not reached_goal(record, params):
+        return False
+    return params.success_rule == "goal" or count_contacts(record.collision) < 2
+
+
 @metric("success", unit="1", description="1 if the episode succeeded and ended inside the goal")
 def success(record: EpisodeRecord, params: MetricParams) -> float:
-    """1.0 iff ``outcome == "success"`` and ``‖p_T − goal‖ ≤ goal_radius`` (2-D), else 0.0."""
-    return 1.0 if reached_goal(record, params) else 0.0
+    """1 if the episode succeeded and ended inside the goal.
+
+    1.0 iff ``outcome == "success"`` and ``‖p_T − goal‖ ≤ goal_radius`` (2-D), and, with
+    ``success_rule="arena"`` (the Arena 3.0 paper's rule), fewer than 2 collisions (see
+    ``collisions``); else 0.0. The default rule "goal" ignores collisions.
+    """
+    return 1.0 if succeeded(record, params) else 0.0
 
 
 @metric("collisions", unit="-", description="number of collisions (rising edges of contact)")
 def collisions(record: EpisodeRecord, params: MetricParams) -> float:
     """Number of collisions (rising edges of contact).
 
-    Count of rows where ``record.collision`` turns on; the state before row 0 counts as
-    "no contact", so a contact at row 0 is one collision (Arena does not count it).
+    Count of rows where ``record.collision`` (contact of any kind) turns on; the state before
+    row 0 counts as "no contact", so a contact at row 0 is one collision (Arena does not count
+    it).
     """
-    c = record.collision.astype(np.int8)
-    return float(np.count_nonzero(np.diff(c, prepend=np.int8(0)) > 0))
+    return float(count_contacts(record.collision))
+
+
+@metric("collisions_static", unit="-", description="collisions with walls and obstacles")
+def collisions_static(record: EpisodeRecord, params: MetricParams) -> float:
+    """Collisions with walls and obstacles.
+
+    Rising edges (as ``collisions``) of ``collision_wall | collision_obstacle``: a contact that
+    moves from a wall onto an adjoining obstacle is one collision.
+    """
+    return float(count_contacts(record.collision_wall | record.collision_obstacle))
+
+
+@metric("collisions_pedestrian", unit="-", description="collisions with pedestrians")
+def collisions_pedestrian(record: EpisodeRecord, params: MetricParams) -> float:
+    """Rising edges (as ``collisions``) of ``collision_pedestrian`` (any pedestrian)."""
+    return float(count_contacts(record.collision_pedestrian))
+
+
+@metric("collisions_robot", unit="-", description="collisions with other robots")
+def collisions_robot(record: EpisodeRecord, params: MetricParams) -> float:
+    """Rising edges (as ``collisions``) of ``collision_robot`` (any other robot)."""
+    return float(count_contacts(record.collision_robot))
 
 
 @metric("time_to_goal", unit="s", description="time from reset to reaching the goal")
@@ -272,10 +316,13 @@ def angle_over_length(record: EpisodeRecord, params: MetricParams) -> float:
     jumps left out of both sums); NaN if the path length is 0.
     """
     length = path_length_value(record)
-    if length <= 0:
-        return math.nan
+    return heading_change_value(record) / length if length > 0 else math.nan
+
+
+def heading_change_value(record: EpisodeRecord) -> float:
+    """rad, ``Σ_j angle_diff(ψ_{j+1}, ψ_j)`` over the driven segments (teleport jumps left out)."""
     turn = angle_diff(record.pose[1:, 2], record.pose[:-1, 2])
-    return float(np.sum(turn[driven_segments(record)]) / length)
+    return float(np.sum(turn[driven_segments(record)]))
 
 
 @metric("time_in_private_zone", unit="s", description="time a pedestrian was in the private zone")
@@ -324,7 +371,9 @@ def time_seen_by_pedestrians(record: EpisodeRecord, params: MetricParams) -> flo
 
 __all__ = [
     "acceleration_values",
+    "count_contacts",
     "goal_distance",
+    "heading_change_value",
     "jerk_values",
     "menger_curvature",
     "path_length_value",
@@ -332,4 +381,5 @@ __all__ = [
     "resampled_triples",
     "segment_lengths",
     "step_dt",
+    "succeeded",
 ]

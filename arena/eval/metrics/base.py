@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,10 +48,13 @@ class MetricParams(BaseModel, frozen=True, extra="forbid"):
         math.radians(5.0), gt=0, description="rad, half-cone of a pedestrian's gaze (Arena: 5°)"
     )
     personal_space_radius: float = Field(
-        1.2, gt=0, description="m, Hall (1966) personal distance, close phase (centre distance)"
+        1.2, gt=0, description="m, body gap robot-pedestrian (centre distance less both radii) "
+        "below which a pedestrian is in the personal space: Hall (1966) personal distance, close "
+        "phase; Francis et al. (2023) use 0.5 m",
     )
     intimate_space_radius: float = Field(
-        0.45, gt=0, description="m, Hall (1966) intimate distance (centre distance)"
+        0.45, gt=0, description="m, body gap robot-pedestrian below which a pedestrian is in the "
+        "intimate space: Hall (1966) intimate distance",
     )
     group_distance: float = Field(
         1.5, gt=0, description="m, pedestrians closer than this are linked into one group"
@@ -77,6 +80,12 @@ class MetricParams(BaseModel, frozen=True, extra="forbid"):
     cf_displacement_threshold: float = Field(
         0.2, gt=0, description="m, a person farther than this from their counterfactual "
         "position (the crowd replayed without the robot) counts as displaced",
+    )
+    success_rule: Literal["goal", "arena"] = Field(
+        "goal", description="when an episode succeeds: 'goal' (default) = outcome success and "
+        "the final position inside the goal radius, collisions allowed (collisions never end an "
+        "episode here); 'arena' = the same and fewer than 2 collisions (the Arena 3.0 paper's "
+        "rule, for Arena-compatible tables; Arena's code: fewer than 3)",
     )
     goal_tolerance: float = Field(
         1e-9, ge=0, description="m, float slack added to the goal radius in the success test"

@@ -1,7 +1,8 @@
 """Social-navigation metrics after Francis et al. (2023), Guzzi et al. (2013) and Helbing (1995).
 
-Radii (centre distances unless said otherwise): personal space 1.2 m and intimate space 0.45 m
-(Hall 1966, close phases); groups link pedestrians closer than 1.5 m. All are
+Personal space 1.2 m and intimate space 0.45 m (Hall 1966, close phases; Francis et al. 2023 use
+0.5 m for personal space) are body gaps, the centre distance less both radii; groups link
+pedestrians whose centres are closer than 1.5 m. All are
 :class:`~arena.eval.metrics.base.MetricParams` fields.
 """
 
@@ -14,9 +15,11 @@ import numpy as np
 from arena.eval.metrics.arena_set import (
     acceleration_values,
     goal_distance,
+    heading_change_value,
     jerk_values,
+    menger_curvature,
     path_length_value,
-    reached_goal,
+    succeeded,
 )
 from arena.eval.metrics.base import (
     FloatArray,
@@ -79,11 +82,12 @@ def stalled_time(record: EpisodeRecord, params: MetricParams) -> float:
 def spl(record: EpisodeRecord, params: MetricParams) -> float:
     """Success weighted by (shortest / actual) path length.
 
-    Dimensionless, ``S · ℓ / max(p, ℓ)``: S success (0/1), ℓ the shortest path length
+    Dimensionless, ``S · ℓ / max(p, ℓ)``: S the ``success`` metric (0/1, under
+    ``success_rule``), ℓ the shortest path length
     (``shortest_path`` or the straight line start→goal), p the driven 2-D path length; 1.0 for a
     success with ``ℓ = p = 0``.
     """
-    if not reached_goal(record, params):
+    if not succeeded(record, params):
         return 0.0
     ell, p = shortest_length(record, params), path_length_value(record)
     return 1.0 if max(ell, p) <= 0 else ell / max(ell, p)
@@ -122,6 +126,49 @@ def jerk_max(record: EpisodeRecord, params: MetricParams) -> float:
     """m/s³, maximum of the jerk magnitudes (see ``jerk``); NaN with fewer than 3 rows."""
     j = jerk_values(record)
     return float(np.max(j)) if j.size else math.nan
+
+
+@metric("acceleration_min", unit="m/s^2", description="smallest acceleration magnitude")
+def acceleration_min(record: EpisodeRecord, params: MetricParams) -> float:
+    """Smallest acceleration magnitude (Francis et al. 2023, A_min).
+
+    m/s², ``min ‖Δv‖/Δt`` over consecutive pairs of rows (world-frame velocity vectors, the
+    values ``acceleration`` and ``acceleration_max`` use); NaN with fewer than 2 rows.
+    """
+    a = acceleration_values(record)
+    return float(np.min(a)) if a.size else math.nan
+
+
+@metric("jerk_min", unit="m/s^3", description="smallest jerk magnitude")
+def jerk_min(record: EpisodeRecord, params: MetricParams) -> float:
+    """Smallest jerk magnitude (Francis et al. 2023, J_min).
+
+    m/s³, minimum of the jerk magnitudes per consecutive triple of rows (the values ``jerk``
+    and ``jerk_max`` use); NaN with fewer than 3 rows.
+    """
+    j = jerk_values(record)
+    return float(np.min(j)) if j.size else math.nan
+
+
+@metric("curvature_min", unit="1/m", description="smallest Menger curvature of the path")
+def curvature_min(record: EpisodeRecord, params: MetricParams) -> float:
+    """Smallest Menger curvature of the path (Arena 3.0 paper).
+
+    1/m, minimum over consecutive 2-D triples of rows of ``4·Area/(|p0p1|·|p1p2|·|p0p2|)``
+    (0 for a degenerate triple, as ``curvature`` and ``curvature_max``); NaN with < 3 rows.
+    """
+    k = menger_curvature(record)
+    return float(np.min(k)) if k.size else math.nan
+
+
+@metric("heading_change", unit="rad", description="cumulative heading change over the path")
+def heading_change(record: EpisodeRecord, params: MetricParams) -> float:
+    """Cumulative heading change over the driven path (Francis et al. 2023).
+
+    rad, ``Σ_j angle_diff(ψ_{j+1}, ψ_j)`` (each step's yaw change in ``[0, π]``) over the
+    driven segments, teleport jumps left out; 0 with fewer than 2 rows.
+    """
+    return heading_change_value(record)
 
 
 @metric("min_distance_to_person", unit="m", description="smallest body gap robot-pedestrian")
@@ -174,25 +221,32 @@ def _compliance(record: EpisodeRecord, radius: float) -> float:
     if record.steps == 0:
         return math.nan
     _, dist = ped_offsets(record)
-    return 1.0 - float(np.mean(any_per_step(record, dist <= radius)))
+    gap = dist - record.ped_radius - record.meta.robot_radius
+    return 1.0 - float(np.mean(any_per_step(record, gap < radius)))
 
 
-@metric("personal_space_compliance", unit="1", description="share of steps nobody within 1.2 m")
+@metric("personal_space_compliance", unit="1",
+        description="share of steps with no body gap to a person below the personal radius")
 def personal_space_compliance(record: EpisodeRecord, params: MetricParams) -> float:
-    """Share of steps nobody within 1.2 m.
+    """Share of steps with no body gap to a person below the personal radius.
 
-    Dimensionless, fraction of rows with no pedestrian centre within
-    ``personal_space_radius`` (1.2 m, Hall 1966) of the robot centre; NaN without rows.
+    Dimensionless, fraction of rows where every pedestrian's body gap
+    ``‖p_ped − p_robot‖ − r_ped − r_robot`` (m, the robot's bounding circle
+    ``meta.robot_radius``, the pedestrian's ``ped_radius``) is at least
+    ``personal_space_radius`` (default 1.2 m, Hall 1966; Francis et al. 2023: 0.5 m); 1.0
+    without pedestrians, NaN without rows.
     """
     return _compliance(record, params.personal_space_radius)
 
 
-@metric("intimate_space_compliance", unit="1", description="share of steps nobody within 0.45 m")
+@metric("intimate_space_compliance", unit="1",
+        description="share of steps with no body gap to a person below the intimate radius")
 def intimate_space_compliance(record: EpisodeRecord, params: MetricParams) -> float:
-    """Share of steps nobody within 0.45 m.
+    """Share of steps with no body gap to a person below the intimate radius.
 
-    Dimensionless, fraction of rows with no pedestrian centre within
-    ``intimate_space_radius`` (0.45 m, Hall 1966) of the robot centre; NaN without rows.
+    Dimensionless, fraction of rows where every pedestrian's body gap
+    ``‖p_ped − p_robot‖ − r_ped − r_robot`` (m) is at least ``intimate_space_radius``
+    (default 0.45 m, Hall 1966); 1.0 without pedestrians, NaN without rows.
     """
     return _compliance(record, params.intimate_space_radius)
 
