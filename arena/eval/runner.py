@@ -120,9 +120,9 @@ def _generator(config_json: str) -> Any:
 
 
 def _nan_metrics() -> dict[str, float]:
-    from arena.eval.metrics import METRICS
+    from arena.experiment import episode_metrics
 
-    return {n: math.nan for n in METRICS.names()}
+    return episode_metrics(None)[0]
 
 
 def _base_row(job: Job) -> dict[str, Any]:
@@ -163,8 +163,7 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
     import json
 
     import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
-    from arena.eval.metrics import compute_metrics
-    from arena.experiment import describe_exception, run_episode
+    from arena.experiment import describe_exception, episode_metrics, run_episode
     from arena.sim.backend import BACKENDS
 
     t0 = time.perf_counter()
@@ -181,13 +180,9 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
         row.update(outcome=res.outcome, time=float(res.time), path_length=res.path_length,
                    collisions=int(res.collisions), error=res.error)
         record = res.record
-        if record is not None:
-            try:
-                metrics.update(compute_metrics(record))
-            except Exception as e:  # a metric bug must not lose the episode
-                row["error"] = (row["error"] + "; " if row["error"] else "") + (
-                    f"metrics: {type(e).__name__}: {e}"
-                )
+        metrics, problem = episode_metrics(record)  # a metric bug must not lose the episode
+        if problem:
+            row["error"] = f"{row['error']}; {problem}" if row["error"] else problem
     except Exception as e:
         row["outcome"] = "error"
         row["error"] = describe_exception(e)

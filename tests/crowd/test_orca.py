@@ -7,6 +7,7 @@ from ``compute()``, then ``p += v·dt``. pyrvo gets the same preferred velocity
 """
 
 import numpy as np
+import pyrvo  # the RVO2 reference, a test extra: its absence must fail, not skip
 import pytest
 from pydantic import ValidationError
 
@@ -111,7 +112,6 @@ def walls_of(segments):
 
 
 def pyrvo_sim(pos, *, polygons=(), time_horizon_obst=REF_OBST):
-    pyrvo = pytest.importorskip("pyrvo")
     sim = pyrvo.RVOSimulator(
         DT,
         REF["neighbor_dist"],
@@ -250,7 +250,6 @@ def test_rvo2_matches_rvo2_in_a_room_with_two_boxes():
     # at reset, as the simulator runs it. The map's walls go to both as segments.
     world = room_with_two_boxes()
     pos, goals = circle(16, 3.8)
-    pyrvo = pytest.importorskip("pyrvo")
     sim = pyrvo.RVOSimulator(DT, *REF.values(), REF_OBST, RADIUS, VMAX)
     for p in pos:
         sim.add_agent((float(p[0]), float(p[1])))

@@ -196,7 +196,13 @@ def _wait_for(condition: Any, what: str, bound: float = BOUND_S) -> None:
         time.sleep(0.1)
 
 
-@pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="needs Linux /proc")
+#: Process parents and states are read from /proc: Linux, where CI runs (and where the kill
+#: with the parent, PR_SET_PDEATHSIG, lives).
+NEEDS_PROC = pytest.mark.skipif(not Path("/proc/self/stat").is_file(),
+                                reason="reads process parents and states from Linux /proc")
+
+
+@NEEDS_PROC
 @pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGTERM])
 def test_workers_exit_with_a_killed_parent(sig: signal.Signals, fault_plugin: Path,
                                            suite: Path, tmp_path: Path) -> None:
@@ -231,7 +237,7 @@ def test_workers_exit_with_a_killed_parent(sig: signal.Signals, fault_plugin: Pa
                 os.kill(p, signal.SIGKILL)
 
 
-@pytest.mark.skipif(not Path("/proc/self/stat").is_file(), reason="needs Linux /proc")
+@NEEDS_PROC
 def test_watchdog_alone_ends_an_orphaned_worker(tmp_path: Path) -> None:
     """The portable fallback (no PR_SET_PDEATHSIG): the worker's watchdog sees the new ppid."""
     armed = tmp_path / "armed"  # the grandchild writes its pid there once its watchdog runs

@@ -6,10 +6,9 @@ import sys
 import textwrap
 
 import pytest
+import ray  # a test extra: its absence must fail, not skip
 
 from arena import cli
-
-ray = pytest.importorskip("ray")
 
 PLANNER = '''
 """A user's planner for the ray test."""
@@ -45,8 +44,8 @@ def test_bench_on_ray_with_a_plugin_planner(monkeypatch, capsys, tmp_path):
     from arena.eval.store import load_results
     from arena.nav import LOCAL_PLANNERS
 
-    if ray.is_initialized():  # pragma: no cover - a Ray started before the plugin was loaded
-        pytest.skip("a Ray session is already up")
+    if ray.is_initialized():  # a Ray another test left up lacks the plugin: the bench starts
+        ray.shutdown()        # its own, which passes ARENA_PLUGINS on to the workers
     monkeypatch.delenv(plugins.PLUGINS_ENV, raising=False)
     monkeypatch.setenv("RAY_USAGE_STATS_ENABLED", "0")
     path = tmp_path / "ray_planner.py"
