@@ -369,6 +369,12 @@ def tasks_preview(
     contest: Annotated[
         str | None, typer.Option(help="packaged contest name or YAML path")
     ] = None,
+    worlds: Annotated[
+        Path | None,
+        typer.Option("--worlds", metavar="DIR",
+                     help="folder of worlds in Arena's layout: the suite's world names are "
+                          "looked up there first (as arena bench --worlds)"),
+    ] = None,
 ) -> None:
     """Draw every episode of a suite and print a table (no simulation)."""
     from arena.config.schema import ExperimentConfig
@@ -380,7 +386,8 @@ def tasks_preview(
 
     base = ExperimentConfig(seed=seed)
     task = TaskConfig.model_validate(
-        {"modules": [{"type": "benchmark", "suite": suite, "scale_episodes": scale}]}
+        {"modules": [{"type": "benchmark", "suite": suite, "scale_episodes": scale,
+                      "worlds": None if worlds is None else str(worlds)}]}
     )
     gen = TaskGenerator(task, map_spec=base.map, robots=[load_robot(base.robot)], seed=seed)
     contestants = []

@@ -65,6 +65,13 @@ def bench(
     report: Annotated[
         bool, typer.Option("--report/--no-report", help="then write the HTML report (RUN/report)")
     ] = False,
+    worlds: Annotated[
+        Path | None,
+        typer.Option("--worlds", metavar="DIR",
+                     help="folder of worlds in Arena's layout (<world>/map/map.yaml, e.g. "
+                          "arena-simulation-setup/worlds): the suite's world names are looked "
+                          "up there first \\[default: the suite's worlds key; resume: the run's]"),
+    ] = None,
     plugin: PluginOption = None,
     episode_timeout: Annotated[
         float | None,
@@ -97,6 +104,8 @@ def bench(
         contest = contest if contest is not None else str(manifest["contest"])
         seed = seed if seed is not None else int(manifest["seed"])
         scale = scale if scale is not None else float(manifest["scale"])
+        if worlds is None and manifest.get("worlds") is not None:
+            worlds = Path(str(manifest["worlds"]))
     contest = contest if contest is not None else "basic"
     seed = seed if seed is not None else 0
     scale = scale if scale is not None else 1.0
@@ -133,7 +142,7 @@ def bench(
         run = run_benchmark(
             suite, contest, run_dir, base_cfg=base_cfg, workers=workers,
             resume=resume is not None, scale=scale, progress=progress, backend=backend.value,
-            ray_address=ray_address, **limit,
+            ray_address=ray_address, worlds=worlds, **limit,
         )
     _print_bench_tables(load_results(run), f"{suite} · {Path(contest).stem} · seed {seed}")
     console.print(f"run folder: {run}")

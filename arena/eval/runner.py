@@ -233,6 +233,7 @@ def run_benchmark(
     backend: str = "process",
     ray_address: str | None = None,
     episode_timeout: float | None = DEFAULT_EPISODE_TIMEOUT,
+    worlds: str | Path | None = None,
 ) -> Path:
     """Run (or resume) a benchmark into ``run_dir``; return the run folder.
 
@@ -258,6 +259,9 @@ def run_benchmark(
         episode_timeout: wall-clock limit of one episode (s), ``None`` for none: an episode
             past it has its worker (ray: its task) killed and ends as ``error``. Like
             ``workers`` and ``backend`` it is not part of the run's settings.
+        worlds: the folder of worlds in Arena's layout that the suite's world names are looked
+            up in first (:mod:`arena.tasks.suite`); ``None``: the suite's ``worlds`` key, if
+            any. Part of the run's settings (the manifest keeps the folder used).
 
     Warns:
         UserWarning: once per stage that ``scale`` drops to 0 episodes.
@@ -292,7 +296,7 @@ def run_benchmark(
     if isinstance(suite, Suite):
         suite_obj, scale = suite, suite.scale_episodes
     else:
-        suite_obj = load_suite(suite, scale_episodes=scale)
+        suite_obj = load_suite(suite, scale_episodes=scale, worlds=worlds)
     if isinstance(contest, ContestFile):
         contest_obj, contest_src = contest, "<contest>"
     else:
@@ -304,6 +308,7 @@ def run_benchmark(
     settings: dict[str, Any] = {
         "suite": suite_src, "contest": contest_src, "seed": int(base_cfg.seed),
         "scale": float(scale),
+        "worlds": None if suite_obj.worlds is None else str(suite_obj.worlds),
     }
     check_scale(suite_obj, suite_src)
     jobs = plan_jobs(suite_obj, contest_obj, base_cfg, contest_source=contest_src)
@@ -318,7 +323,7 @@ def run_benchmark(
         try:
             run.mkdir(parents=True, exist_ok=True)
             write_manifest(run, suite=suite_src, contest=contest_src, seed=int(base_cfg.seed),
-                           scale=float(scale))
+                           scale=float(scale), worlds=settings["worlds"])
         except OSError as e:
             raise ArenaError(f"{run}: cannot create the run folder ({e.strerror or e})") from None
     done = completed(run)

@@ -44,7 +44,7 @@ from arena.eval.record import EpisodeRecord
 MANIFEST = "run.json"
 EPISODES = "episodes"
 #: Manifest keys a resumed run must match.
-MANIFEST_KEYS = ("suite", "contest", "seed", "scale")
+MANIFEST_KEYS = ("suite", "contest", "seed", "scale", "worlds")
 
 #: Columns of :func:`load_results` before the metric columns, with their types.
 ID_COLUMNS: tuple[tuple[str, pa.DataType], ...] = (
@@ -105,14 +105,16 @@ def episode_stem(run: Path, contestant: str, stage: str, episode: int) -> Path:
 
 # -- manifest ---------------------------------------------------------------------------------
 def write_manifest(
-    run: str | Path, *, suite: str, contest: str, seed: int, scale: float
+    run: str | Path, *, suite: str, contest: str, seed: int, scale: float,
+    worlds: str | None = None,
 ) -> dict[str, Any]:
-    """Write ``<run>/run.json`` for a new run and return it."""
+    """Write ``<run>/run.json`` for a new run and return it (``worlds``: the worlds folder)."""
     data: dict[str, Any] = {
         "suite": str(suite),
         "contest": str(contest),
         "seed": int(seed),
         "scale": float(scale),
+        "worlds": None if worlds is None else str(worlds),
         "created": datetime.now(UTC).isoformat(timespec="seconds"),
         "arena_version": __version__,
     }
@@ -129,6 +131,7 @@ class RunManifest(BaseModel):
     contest: StrictStr = Field(min_length=1)
     seed: StrictInt = Field(ge=0)
     scale: StrictFloat = Field(gt=0)
+    worlds: StrictStr | None = Field(None, min_length=1)
 
 
 def read_manifest(run: str | Path) -> dict[str, Any]:

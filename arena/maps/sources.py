@@ -96,6 +96,33 @@ def resolve_world(name_or_folder: str) -> Path:
     )
 
 
+def check_worlds_folder(folder: str | Path, *, source: str | None = None,
+                        path: str | None = None) -> Path:
+    """A folder of worlds in Arena's layout (``<world>/map/map.yaml``), resolved.
+
+    Raises:
+        ConfigError: the folder does not exist or is a file (one line naming ``source``).
+    """
+    p = Path(folder).expanduser()
+    what = ("expected a folder of worlds in Arena's layout, <world>/map/map.yaml "
+            "(e.g. arena-simulation-setup/worlds)")
+    if not p.exists():
+        raise ConfigError(f"no folder {str(p)!r}; {what}", source=source, path=path)
+    if not p.is_dir():
+        raise ConfigError(f"{str(p)!r} is a file; {what}", source=source, path=path)
+    return p.resolve()
+
+
+def worlds_in(folder: Path) -> list[str]:
+    """Names of the worlds in a folder: its sub-folders holding ``map/map.yaml`` or ``map.yaml``."""
+    try:
+        subs = sorted(folder.iterdir())
+    except OSError:
+        return []
+    return [c.name for c in subs
+            if (c / "map" / "map.yaml").is_file() or (c / "map.yaml").is_file()]
+
+
 def world_folder(name_or_folder: str) -> Path:
     """The folder of a packaged world name or world folder (holding ``map/``, ``scenarios/``)."""
     map_yaml = resolve_world(name_or_folder)

@@ -16,11 +16,27 @@ folder, Arena's ``worlds/<map>/scenarios/``), ``timeout`` and ``goal_radius`` â†
 are simulated bodies with no mesh, so the names are accepted and ignored. ``RANDOM.seed``
 replaces the stage seed (Arena applies the stage's ``config`` after the stage seed).
 
-Our native additions per stage: ``map`` may be a packaged world name, a world folder (relative
-to the suite file), Arena's ``dynamic_map`` (the run's generated map) or a map block
-(``{type: canteen, ...}``); ``task:`` is an overlay in our :class:`~arena.tasks.config.TaskConfig`
-format merged last; ``map_per_episode`` (default true) gives a generated map a new instance
-every episode.
+Our native additions per stage: ``map`` may be a packaged world name, a world folder (a path
+with ``/``, relative to the suite file), Arena's ``dynamic_map`` (the run's generated map) or a
+map block (``{type: canteen, ...}``); ``task:`` is an overlay in our
+:class:`~arena.tasks.config.TaskConfig` format merged last; ``map_per_episode`` (default true)
+gives a generated map a new instance every episode.
+
+Worlds by name. Arena's suites name worlds by folder name (``map: arena_hospital_small``), the
+folders of ``arena-simulation-setup/worlds``. A *worlds folder* says where those are: ``arena
+bench SUITE --worlds DIR``, else ``suite.worlds`` of a benchmark ``config.yaml``, else the suite
+file's own ``worlds:`` key (our addition; both paths relative to their file). A world name
+(no ``/``; checked as a file name, :func:`~arena.core.names.check_name`) is looked up, first
+match wins:
+
+1. ``<worlds folder>/<name>/`` (``map/map.yaml`` or ``map.yaml``);
+2. next to the suite: ``<suite dir>/<name>``, ``<suite dir>/worlds/<name>``,
+   ``<suite dir>/../worlds/<name>``;
+3. a folder ``<name>`` in the working directory, then the packaged world ``<name>``.
+
+The worlds folder wins because it is the one place the user named for this run: a world there
+that shares its name with a packaged look-alike is the map the suite's authors meant. A stage's
+``SCENARIO.file`` is then read from ``<world folder>/scenarios/`` (then next to the suite).
 
 A stage's seed defaults to Arena's: the last 4 bytes of the SHA-1 of the stage's canonical JSON
 (sorted keys), as a non-negative int32. The episodes of a stage are drawn from
@@ -41,9 +57,15 @@ from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError, f
 from arena.config.loader import merge
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, from_validation_error
-from arena.core.names import RULE, SafeName
+from arena.core.names import RULE, SafeName, name_problem
 from arena.core.rng import MAX_SEED, Seed, child_seed
-from arena.maps.sources import MAP_SOURCES, resolve_world
+from arena.maps.sources import (
+    MAP_SOURCES,
+    check_worlds_folder,
+    packaged_worlds,
+    resolve_world,
+    worlds_in,
+)
 from arena.tasks.datafiles import find_data_file, read_yaml_any
 
 MAX_EPISODES = 1_000_000
@@ -153,6 +175,11 @@ class SuiteFile(_Arena):
     """``suites/<name>.yaml``."""
 
     stages: list[SuiteStage] = Field(min_length=1, description="stages, unique names")
+    worlds: str | None = Field(
+        None, description="folder of worlds in Arena's layout (<world>/map/map.yaml) that "
+        "world names are looked up in first, relative to this file (our addition; --worlds "
+        "overrides it)",
+    )
 
     @field_validator("stages")
     @classmethod
@@ -189,6 +216,10 @@ class SuiteRef(_Arena):
 
     config: str
     scale_episodes: float = Field(1.0, gt=0)
+    worlds: str | None = Field(
+        None, description="worlds folder for the suite's world names, relative to this file "
+        "(our addition; replaces the suite's own)",
+    )
 
 
 class ContestRef(_Arena):
@@ -237,10 +268,14 @@ class Suite:
         seeds: per stage, the stage seed (explicit, ``RANDOM.seed`` or Arena's SHA-1 default).
         source: the suite file.
         scale_episodes: factor on every stage's episode count (Arena: ``int(episodes Ã— s)``).
+        worlds: the worlds folder world names are looked up in first (see the module docs),
+            checked to exist; ``None``: none.
+        worlds_origin: where ``worlds`` came from, for messages (``--worlds``, a file's key).
     """
 
     def __init__(
-        self, file: SuiteFile, raw: list[dict[str, Any]], source: str, scale_episodes: float = 1.0
+        self, file: SuiteFile, raw: list[dict[str, Any]], source: str, scale_episodes: float = 1.0,
+        *, worlds: Path | None = None, worlds_origin: str = "--worlds",
     ) -> None:
         if not (math.isfinite(scale_episodes) and scale_episodes > 0):
             raise ConfigError(f"scale_episodes must be a finite number > 0, got {scale_episodes}",
@@ -254,6 +289,8 @@ class Suite:
         self.stages = list(file.stages)
         self.source = source
         self.scale_episodes = float(scale_episodes)
+        self.worlds = worlds
+        self.worlds_origin = worlds_origin
         self.seeds = []
         for st, r in zip(self.stages, raw, strict=True):
             seed = st.seed if st.seed is not None else arena_stage_seed(r)
@@ -301,15 +338,54 @@ class Suite:
             if "generator" in MAP_SOURCES.entry(str(base_map.get("type"))).tags:
                 return dict(base_map)
             return {"type": "rosnav_indoor"}
+        return {"type": "world", "name": self._find_world(m, where)}
+
+    def _find_world(self, m: str, where: str) -> str:
+        """The world a stage's ``map`` string names: a folder path or a world name (module docs)."""
         base = Path(self.source).resolve().parent
-        for folder in (base / m, base / "worlds" / m, base.parent / "worlds" / m):
+        is_path = "/" in m or "\\" in m
+        if not is_path:
+            problem = name_problem(m)
+            if problem is not None:
+                raise ConfigError(
+                    f"world name {m!r} {problem}: a world is named by its folder ({RULE}); a "
+                    "world folder elsewhere is a path with '/' (relative to the suite file)",
+                    source=self.source, path=where)
+        folders = [] if is_path or self.worlds is None else [self.worlds / m]
+        folders += [base / m] + ([] if is_path else [base / "worlds" / m,
+                                                      base.parent / "worlds" / m])
+        for folder in folders:
             if (folder / "map" / "map.yaml").is_file() or (folder / "map.yaml").is_file():
-                return {"type": "world", "name": str(folder)}
+                return str(folder)
         try:
             resolve_world(m)
         except ConfigError as e:
-            raise ConfigError(e.message, source=self.source, path=where) from None
-        return {"type": "world", "name": m}
+            raise ConfigError(self._no_world(m, e.message, is_path),
+                              source=self.source, path=where) from None
+        return m
+
+    def _no_world(self, m: str, message: str, is_path: bool) -> str:
+        """The message for a world name found nowhere: close names of the worlds folder."""
+        if is_path:
+            return message
+        if self.worlds is None:
+            return (f"{message}; Arena's suites name the worlds of arena-simulation-setup/worlds: "
+                    "give that folder with --worlds DIR")
+        import difflib
+
+        there = worlds_in(self.worlds)
+        known = there + [w for w in packaged_worlds() if w not in there]
+        close = difflib.get_close_matches(m, known, n=3, cutoff=0.6)
+        hint = f"did you mean {', '.join(map(repr, close))}? " if close else ""
+        if there:
+            held = f"it holds {len(there)} world{'s' if len(there) > 1 else ''}"
+        elif worlds_in(self.worlds / "worlds"):
+            held = f"it holds no <world>/map/map.yaml; did you mean {self.worlds / 'worlds'}?"
+        else:
+            held = "it holds no <world>/map/map.yaml"
+        return (f"no world {m!r} in the worlds folder {self.worlds} ({self.worlds_origin}; "
+                f"{held}), next to the suite or packaged; {hint}packaged worlds: "
+                f"{', '.join(packaged_worlds())}")
 
     def _world_folder(self, map_block: dict[str, Any]) -> Path | None:
         if map_block.get("type") != "world":
@@ -469,11 +545,24 @@ def _stage_error(err: ConfigError, i: int, source: str) -> ConfigError:
     return ConfigError(err.message + detail, source=source, path=where)
 
 
-def load_suite(name_or_path: str | Path, *, scale_episodes: float = 1.0) -> Suite:
+def load_suite(
+    name_or_path: str | Path, *, scale_episodes: float = 1.0, worlds: str | Path | None = None,
+    worlds_option: str = "--worlds",
+) -> Suite:
     """Load a packaged suite (``"paper"``, ``"quick"``) or a suite file.
 
-    Only the file's structure is checked here; worlds and scenarios are resolved by
-    :meth:`Suite.stage_experiments`.
+    Only the file's structure and the worlds folder are checked here; worlds and scenarios are
+    resolved by :meth:`Suite.stage_experiments`.
+
+    Args:
+        name_or_path: packaged name or suite file.
+        scale_episodes: factor on every stage's episode count.
+        worlds: the worlds folder (see the module docs); replaces the file's ``worlds:`` key.
+        worlds_option: what ``worlds`` is called in messages (the CLI option, a config key).
+
+    Raises:
+        ConfigError: a bad file, or a worlds folder that does not exist (naming where it was
+            given).
     """
     path = find_data_file("suites", name_or_path)
     source = str(path)
@@ -483,7 +572,16 @@ def load_suite(name_or_path: str | Path, *, scale_episodes: float = 1.0) -> Suit
             f"expected a mapping {{stages: [...]}}, got {type(data).__name__}", source=source
         )
     file = _validate(SuiteFile, data, source)
-    return Suite(file, list(data["stages"]), source, scale_episodes)
+    if worlds is not None:
+        folder = check_worlds_folder(worlds, source=worlds_option)
+        origin = worlds_option
+    elif file.worlds is not None:
+        folder = check_worlds_folder(path.parent / file.worlds, source=source, path="worlds")
+        origin = f"{source}: worlds"
+    else:
+        folder, origin = None, worlds_option
+    return Suite(file, list(data["stages"]), source, scale_episodes, worlds=folder,
+                 worlds_origin=origin)
 
 
 def load_contest(name_or_path: str | Path) -> tuple[ContestFile, str]:
@@ -521,11 +619,14 @@ def contestant_config(
     return ExperimentConfig.model_validate({**data, "name": contestant.name})
 
 
-def load_benchmark(path: str | Path) -> tuple[Suite, tuple[ContestFile, str] | None]:
+def load_benchmark(
+    path: str | Path, *, worlds: str | Path | None = None
+) -> tuple[Suite, tuple[ContestFile, str] | None]:
     """Arena's benchmark ``config.yaml``: the suite (scaled) and the contest, if any.
 
     ``suite.config`` / ``contest.config`` are looked up in the ``suites/`` / ``contests/``
-    folders next to the file (Arena's layout), then as paths and packaged names.
+    folders next to the file (Arena's layout), then as paths and packaged names. ``worlds``
+    (the ``--worlds`` option) replaces ``suite.worlds``, which replaces the suite's own.
     """
     p = Path(path)
     data = read_yaml_any(p)
@@ -537,7 +638,11 @@ def load_benchmark(path: str | Path) -> tuple[Suite, tuple[ContestFile, str] | N
                 return str(c)
         return name
 
+    option = "--worlds"
+    if worlds is None and bench.suite.worlds is not None:
+        worlds, option = p.parent / bench.suite.worlds, f"{p}: suite.worlds"
     suite = load_suite(find("suites", bench.suite.config),
-                       scale_episodes=bench.suite.scale_episodes)
+                       scale_episodes=bench.suite.scale_episodes, worlds=worlds,
+                       worlds_option=option)
     contest = load_contest(find("contests", bench.contest.config)) if bench.contest else None
     return suite, contest

@@ -47,10 +47,15 @@ class Benchmark(ModuleBase):
         scale_episodes: float = Field(
             1.0, gt=0, description="factor on every stage's episodes (Arena: int(n × scale))"
         )
+        worlds: str | None = Field(
+            None, description="folder of worlds in Arena's layout that the suite's world names "
+            "are looked up in first (arena bench --worlds; default: the suite's worlds key)",
+        )
 
     def __init__(self, params: Params | None = None) -> None:
         self.params = p = params or self.Params()
-        self.suite: Suite = load_suite(p.suite, scale_episodes=p.scale_episodes)
+        self.suite: Suite = load_suite(p.suite, scale_episodes=p.scale_episodes,
+                                       worlds=p.worlds, worlds_option="modules.benchmark.worlds")
         self.num_episodes: int = self.suite.total_episodes
         """Episodes of the whole suite (the run plays exactly these)."""
         self._stages: dict[tuple[int, int], _Stage] = {}
