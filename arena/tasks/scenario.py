@@ -22,7 +22,14 @@ Files are read as Arena's loader reads them (it takes each block's keys with ``d
   ``yaml_path``). The three known ones are fields; anything else lands in
   :attr:`ObstacleEntry.extra`, is written back unchanged and is listed in the warnings.
 * A pedestrian without ``name`` is named ``dynamic_<i>`` (its index, made unique among the
-  file's names; the name is then written on save), with a warning.
+  file's names; the name is then written on save), with a warning; a static or interactive
+  obstacle without ``name`` likewise ``static_<i>`` / ``interactive_<i>`` (Arena: ``""``).
+* An entity without ``pos`` stands at ``[0, 0, 0]``, the map origin, as in Arena
+  (``obj.get("pos", (0, 0, 0))``), with a warning. Two pedestrians without ``pos`` are then on
+  one spot, which is refused (below): arena-rosnav's ``old/Eval_13_02.json`` is such a file.
+* A static or interactive obstacle without ``model`` is refused: Arena's loader reads
+  ``obs["model"]`` and fails on it too. Files of the 2023 task generator name a flatland model
+  file by ``yaml_path`` instead (``long_shelf.model.yaml``), which Arena no longer reads.
 
 Missing keys default as in Arena: lists are empty, positions are ``[0, 0, 0]``, a pedestrian's
 model is ``actor1``, its ``waypoint_mode`` 0 and its ``type`` adult. Positions and waypoints
@@ -299,6 +306,11 @@ class Scenario(BaseModel):
             for key in ("start", "goal"):
                 if key not in r.model_fields_set:
                     out.append(f"robots[{i}].{key}: missing, Arena uses [0, 0, 0]")
+        for group in ("static", "interactive", "dynamic"):
+            for i, entity in enumerate(getattr(self.obstacles, group)):
+                if "pos" not in entity.model_fields_set:
+                    out.append(f"obstacles.{group}[{i}].pos: missing, Arena uses [0, 0, 0] "
+                               "(the map origin)")
         for group in ("static", "interactive"):
             for i, o in enumerate(getattr(self.obstacles, group)):
                 where = f"obstacles.{group}[{i}]"
@@ -393,6 +405,7 @@ def _read_as_arena(data: Any, source: str | None) -> tuple[Any, list[str]]:
     obstacles = out.get("obstacles")
     if isinstance(obstacles, dict):
         obstacles = _drop_unknown(obstacles, "obstacles", "obstacles", ignored, source)
+        _name_obstacles(obstacles, notes, source)
         peds = obstacles.get("dynamic")
         if isinstance(peds, list):
             taken = {p["name"] for p in peds
@@ -426,6 +439,37 @@ def _read_as_arena(data: Any, source: str | None) -> tuple[Any, list[str]]:
         notes.insert(0, line)
         warnings.warn(f"{source or 'scenario'}: {line}", UserWarning, stacklevel=3)
     return out, notes
+
+
+def _name_obstacles(obstacles: dict[str, Any], notes: list[str], source: str | None) -> None:
+    """Name static/interactive obstacles without ``name``; refuse one without ``model``.
+
+    Arena reads ``obj.get("name", "")`` but ``obs["model"]``: a missing name is Arena's empty
+    name (here ``<group>_<i>``, unique among the file's obstacle names, with a note), a missing
+    model fails Arena's loader as it fails here.
+    """
+    groups = [(g, obstacles[g]) for g in ("static", "interactive")
+              if isinstance(obstacles.get(g), list)]
+    taken = {o["name"] for _, group in groups for o in group
+             if isinstance(o, dict) and isinstance(o.get("name"), str)}
+    for g, group in groups:
+        for i, o in enumerate(group):
+            if not isinstance(o, dict):
+                continue
+            where = f"obstacles.{g}[{i}]"
+            if "model" not in o:
+                missing = sum(1 for _, grp in groups for e in grp
+                              if isinstance(e, dict) and "model" not in e)
+                named = (f"; it names a flatland model file by yaml_path {o['yaml_path']!r} "
+                         "(the 2023 task generator's format)" if "yaml_path" in o else "")
+                raise ConfigError(
+                    f"required key is missing: Arena's loader reads obs['model'] and fails "
+                    f"without it too{named}; give a model of the obstacle library "
+                    f"({missing} obstacle(s) of the file lack one)",
+                    source=source, path=f"{where}.model")
+            if "name" not in o:
+                group[i] = o = {**o, "name": _unique(f"{g}_{i}", taken)}
+                notes.append(f"{where}.name: missing, named {o['name']!r} (Arena: '')")
 
 
 def parse_scenario(text: str, *, source: str | None = None) -> Scenario:

@@ -127,10 +127,16 @@ def check_layout(
         if same:
             i, j = min(same, key=lambda ij: (ij[1], ij[0]))  # the first entry on a taken spot
             gap = float(np.hypot(*(xy[j] - xy[i])))
+            unset = [k for k in (i, j) if "pos" not in peds[k].model_fields_set]
+            why = ""
+            if unset:
+                keys = " and ".join(f"obstacles.dynamic[{k}]" for k in unset)
+                why = (f"; {keys} {'has' if len(unset) == 1 else 'have'} no pos, so Arena "
+                       "starts them at [0, 0, 0]")
             raise ConfigError(
                 f"starts {gap:.3g} m from obstacles.dynamic[{i}] ({peds[i].name!r}): two "
                 f"people on one spot (closer than {ONE_SPOT:g} m, the direction between them "
-                f"is undefined for every crowd model)",
+                f"is undefined for every crowd model){why}",
                 source=source, path=f"obstacles.dynamic[{j}].pos",
             )
         overlapping = tree.query_pairs(2 * DEFAULT_PED_RADIUS * (1 - 1e-9))

@@ -120,10 +120,12 @@ def test_resume_keeps_the_runs_worlds_folder(layout: tuple[Path, Path], tmp_path
     # resumed without --worlds: the manifest's folder, nothing left to run
     monkeypatch.setattr(sys, "argv", ["arena", "bench", str(suite), "--resume", str(run),
                                       "--workers", "0", "--no-progress"])
+    code = 0
     try:
         cli.main()
     except SystemExit as e:
-        assert not e.code, capsys.readouterr().err
+        code = int(e.code or 0)
+    assert code == 0, capsys.readouterr().err
     assert len(load_results(run).to_pylist()) == 1
 
 
@@ -175,7 +177,7 @@ def test_errors(layout: tuple[Path, Path], tmp_path: Path) -> None:
     assert str(e.value).startswith("--worlds: no folder ") and "nope" in str(e.value)
     assert "<world>/map/map.yaml" in str(e.value)
     (tmp_path / "file").write_text("x")
-    with pytest.raises(ConfigError, match="--worlds: .*file.* is a file"):
+    with pytest.raises(ConfigError, match=r"--worlds: .*file.* is a file"):
         load_suite(suite, worlds=tmp_path / "file")
 
     def stage_error(world: str, folder: Path | None = worlds) -> ConfigError:
