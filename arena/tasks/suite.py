@@ -22,20 +22,9 @@ map block (``{type: canteen, ...}``); ``task:`` is an overlay in our
 :class:`~arena.tasks.config.TaskConfig` format merged last; ``map_per_episode`` (default true)
 gives a generated map a new instance every episode.
 
-Worlds by name. Arena's suites name worlds by folder name (``map: arena_hospital_small``), the
-folders of ``arena-simulation-setup/worlds``. A *worlds folder* says where those are: ``arena
-bench SUITE --worlds DIR``, else ``suite.worlds`` of a benchmark ``config.yaml``, else the suite
-file's own ``worlds:`` key (our addition; both paths relative to their file). A world name
-(no ``/``; checked as a file name, :func:`~arena.core.names.check_name`) is looked up, first
-match wins:
-
-1. ``<worlds folder>/<name>/`` (``map/map.yaml`` or ``map.yaml``);
-2. next to the suite: ``<suite dir>/<name>``, ``<suite dir>/worlds/<name>``,
-   ``<suite dir>/../worlds/<name>``;
-3. a folder ``<name>`` in the working directory, then the packaged world ``<name>``.
-
-The worlds folder wins because it is the one place the user named for this run: a world there
-that shares its name with a packaged look-alike is the map the suite's authors meant. A stage's
+World names (``map: arena_hospital_small``, Arena's folder names) are looked up in a *worlds
+folder* first (``arena bench --worlds DIR``, ``suite.worlds`` of a benchmark ``config.yaml`` or
+the suite's own ``worlds:`` key): see :mod:`arena.tasks.suite_worlds`. A stage's
 ``SCENARIO.file`` is then read from ``<world folder>/scenarios/`` (then next to the suite).
 
 A stage's seed defaults to Arena's: the last 4 bytes of the SHA-1 of the stage's canonical JSON
@@ -57,16 +46,11 @@ from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError, f
 from arena.config.loader import merge
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, from_validation_error
-from arena.core.names import RULE, SafeName, name_problem
+from arena.core.names import RULE, SafeName
 from arena.core.rng import MAX_SEED, Seed, child_seed
-from arena.maps.sources import (
-    MAP_SOURCES,
-    check_worlds_folder,
-    packaged_worlds,
-    resolve_world,
-    worlds_in,
-)
+from arena.maps.sources import MAP_SOURCES, check_worlds_folder, resolve_world
 from arena.tasks.datafiles import find_data_file, read_yaml_any
+from arena.tasks.suite_worlds import find_stage_world
 
 MAX_EPISODES = 1_000_000
 """Most episodes a (scaled) suite may have: weeks of simulation; more is a typo in a scale."""
@@ -338,54 +322,12 @@ class Suite:
             if "generator" in MAP_SOURCES.entry(str(base_map.get("type"))).tags:
                 return dict(base_map)
             return {"type": "rosnav_indoor"}
-        return {"type": "world", "name": self._find_world(m, where)}
-
-    def _find_world(self, m: str, where: str) -> str:
-        """The world a stage's ``map`` string names: a folder path or a world name (module docs)."""
-        base = Path(self.source).resolve().parent
-        is_path = "/" in m or "\\" in m
-        if not is_path:
-            problem = name_problem(m)
-            if problem is not None:
-                raise ConfigError(
-                    f"world name {m!r} {problem}: a world is named by its folder ({RULE}); a "
-                    "world folder elsewhere is a path with '/' (relative to the suite file)",
-                    source=self.source, path=where)
-        folders = [] if is_path or self.worlds is None else [self.worlds / m]
-        folders += [base / m] + ([] if is_path else [base / "worlds" / m,
-                                                      base.parent / "worlds" / m])
-        for folder in folders:
-            if (folder / "map" / "map.yaml").is_file() or (folder / "map.yaml").is_file():
-                return str(folder)
         try:
-            resolve_world(m)
+            name = find_stage_world(m, suite_file=Path(self.source), worlds=self.worlds,
+                                    origin=self.worlds_origin)
         except ConfigError as e:
-            raise ConfigError(self._no_world(m, e.message, is_path),
-                              source=self.source, path=where) from None
-        return m
-
-    def _no_world(self, m: str, message: str, is_path: bool) -> str:
-        """The message for a world name found nowhere: close names of the worlds folder."""
-        if is_path:
-            return message
-        if self.worlds is None:
-            return (f"{message}; Arena's suites name the worlds of arena-simulation-setup/worlds: "
-                    "give that folder with --worlds DIR")
-        import difflib
-
-        there = worlds_in(self.worlds)
-        known = there + [w for w in packaged_worlds() if w not in there]
-        close = difflib.get_close_matches(m, known, n=3, cutoff=0.6)
-        hint = f"did you mean {', '.join(map(repr, close))}? " if close else ""
-        if there:
-            held = f"it holds {len(there)} world{'s' if len(there) > 1 else ''}"
-        elif worlds_in(self.worlds / "worlds"):
-            held = f"it holds no <world>/map/map.yaml; did you mean {self.worlds / 'worlds'}?"
-        else:
-            held = "it holds no <world>/map/map.yaml"
-        return (f"no world {m!r} in the worlds folder {self.worlds} ({self.worlds_origin}; "
-                f"{held}), next to the suite or packaged; {hint}packaged worlds: "
-                f"{', '.join(packaged_worlds())}")
+            raise ConfigError(e.message, source=self.source, path=where) from None
+        return {"type": "world", "name": name}
 
     def _world_folder(self, map_block: dict[str, Any]) -> Path | None:
         if map_block.get("type") != "world":
@@ -467,11 +409,22 @@ class Suite:
     def stage_experiments(
         self, base_cfg: ExperimentConfig
     ) -> list[tuple[SuiteStage, ExperimentConfig]]:
-        """One experiment per stage, run on its own equal to the stage inside the suite.
+        """One experiment per stage (:meth:`stage_experiment`), stages scaled to 0 left out.
+
+        Raises:
+            ConfigError: as :meth:`stage_experiment`, for the first stage that fails.
+        """
+        return [(st, self.stage_experiment(i, base_cfg))
+                for i, (st, n) in enumerate(zip(self.stages, self.episode_counts, strict=True))
+                if n > 0]
+
+    def stage_experiment(self, i: int, base_cfg: ExperimentConfig) -> ExperimentConfig:
+        """Stage ``i`` as an experiment, run on its own equal to the stage inside the suite.
 
         The experiment's seed is :func:`stage_run_seed` of ``base_cfg.seed`` and the stage
         seed; a generated map that changes per episode gets ``dynamic_map`` (one map per
-        episode). Stages scaled to 0 episodes are left out.
+        episode). Its episodes are the stage's after ``scale_episodes`` (at least 1, so that a
+        stage scaled away can still be drawn on its own).
 
         Raises:
             ConfigError: a missing world or scenario, an unknown mode or model, naming the
@@ -480,40 +433,36 @@ class Suite:
         from arena.config.loader import validate_plugins
 
         base = base_cfg.model_dump(mode="json")
-        out = []
-        for i, (st, n) in enumerate(zip(self.stages, self.episode_counts, strict=True)):
-            if n == 0:
-                continue
-            map_block = self.stage_map(i, base["map"])
-            try:
-                task = self.stage_task(i, base["task"], map_block)
-            except ConfigError as e:
-                if e.source is None:
-                    raise e.located(source=self.source, prefix=f"stages[{i}]") from None
-                raise
-            if self.is_generated(map_block) and st.map_per_episode:
-                task["modules"] = [{"type": "dynamic_map", "episodes_per_map": 1},
-                                   *task.get("modules", [])]
-            data = {
-                **base,
-                "name": f"{base_cfg.name}/{st.name}",
-                "seed": stage_run_seed(base_cfg.seed, self.seeds[i]),
-                "episodes": n,
-                "robot": st.robot or base["robot"],
-                "map": map_block,
-                "task": task,
-            }
-            try:
-                cfg = ExperimentConfig.model_validate(data)
-            except ValidationError as e:
-                err = from_validation_error(e, source=self.source)
-                raise _stage_error(err, i, self.source) from None
-            try:
-                validate_plugins(cfg, source=self.source)
-            except ConfigError as e:
-                raise _stage_error(e, i, self.source) from None
-            out.append((st, cfg))
-        return out
+        st = self.stages[i]
+        map_block = self.stage_map(i, base["map"])
+        try:
+            task = self.stage_task(i, base["task"], map_block)
+        except ConfigError as e:
+            if e.source is None:
+                raise e.located(source=self.source, prefix=f"stages[{i}]") from None
+            raise
+        if self.is_generated(map_block) and st.map_per_episode:
+            task["modules"] = [{"type": "dynamic_map", "episodes_per_map": 1},
+                               *task.get("modules", [])]
+        data = {
+            **base,
+            "name": f"{base_cfg.name}/{st.name}",
+            "seed": stage_run_seed(base_cfg.seed, self.seeds[i]),
+            "episodes": max(self.episode_counts[i], 1),
+            "robot": st.robot or base["robot"],
+            "map": map_block,
+            "task": task,
+        }
+        try:
+            cfg = ExperimentConfig.model_validate(data)
+        except ValidationError as e:
+            err = from_validation_error(e, source=self.source)
+            raise _stage_error(err, i, self.source) from None
+        try:
+            validate_plugins(cfg, source=self.source)
+        except ConfigError as e:
+            raise _stage_error(e, i, self.source) from None
+        return cfg
 
     @staticmethod
     def is_generated(map_block: dict[str, Any]) -> bool:
