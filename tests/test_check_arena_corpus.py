@@ -85,10 +85,12 @@ def test_every_file_gets_one_line_and_expected_failures_are_marked(tool, corpus,
 
 
 def test_a_stale_expected_entry_is_xpass(tool, corpus, capsys, monkeypatch):
-    monkeypatch.setattr(tool, "EXPECTED", (("worlds/*/map.yaml", "x", "a stale entry"),))
+    monkeypatch.setattr(tool, "EXPECTED", (("worlds/*/map.yaml", "x", "a stale entry"),
+                                           ("gone/*.json", "x", "a file no longer there")))
     tool.main([str(corpus), "--shared-worlds", str(corpus / "none")])
     out = capsys.readouterr().out
     assert "map.yaml  XPASS  " in out and "update EXPECTED" in out
+    assert "  EXPECTED entry matching no file (remove it?): gone/*.json\n" in out
 
 
 def test_missing_corpus_is_one_clear_line(tool, tmp_path, capsys):

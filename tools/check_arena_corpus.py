@@ -573,11 +573,15 @@ def run_check(kind: str, path: str, args: dict[str, Any]) -> tuple[str, str, flo
 
 
 # -- the report ---------------------------------------------------------------------------------
-def classify(item: Item) -> None:
-    """FAIL → XFAIL where :data:`EXPECTED` lists it; OK → XPASS where it does."""
-    for pattern, text, reason in EXPECTED:
+def classify(item: Item, used: set[int]) -> None:
+    """FAIL → XFAIL where :data:`EXPECTED` lists it; OK → XPASS where it does.
+
+    ``used`` collects the indices of the entries that matched a file.
+    """
+    for k, (pattern, text, reason) in enumerate(EXPECTED):
         if not fnmatch.fnmatch(item.rel, pattern):
             continue
+        used.add(k)
         if item.status == "FAIL" and text in item.detail:
             item.status = "XFAIL"
             item.detail += f" [expected: {reason}]"
@@ -652,12 +656,15 @@ def main(argv: list[str] | None = None) -> int:
                 results = [run_check(*job) for job in jobs]
             finally:  # this process goes on as it was (a caller's own runs simulate)
                 arena.experiment.run_experiment = original  # type: ignore[assignment]
+        used: set[int] = set()
         for it, (status, detail, _) in zip(todo, results, strict=True):
             # paths as the reader sees them: relative to the corpus, the worlds folder named
             it.status = status
             it.detail = detail.replace(worlds, "<worlds>").replace(f"{corpus}{os.sep}", "")
-            classify(it)
+            classify(it, used)
     lines = list(report(items, ns.verbose))
+    lines += [f"  EXPECTED entry matching no file (remove it?): {EXPECTED[k][0]}"
+              for k in range(len(EXPECTED)) if k not in used]
     lines.append(f"  checked in {time.perf_counter() - t0:.0f} s with {ns.jobs} process(es); "
                  "<worlds>: the corpus's and the shared worlds in one folder (--worlds)")
     text = "\n".join(lines) + "\n"

@@ -215,3 +215,21 @@ def test_cli_errors_are_one_line(layout: tuple[Path, Path], tmp_path: Path,
         assert e.value.code == 2 and "Traceback" not in err
         lines = err.strip().splitlines()
         assert len(lines) == 1 and lines[0].startswith("error: ") and fragment in lines[0], err
+
+
+def test_tasks_preview_takes_the_worlds_folder(layout: tuple[Path, Path],
+                                               monkeypatch: pytest.MonkeyPatch,
+                                               capsys: pytest.CaptureFixture[str]) -> None:
+    worlds, suite = layout
+    monkeypatch.setattr(cli.console, "width", 200)
+    monkeypatch.setattr(sys, "argv", ["arena", "tasks", "preview", str(suite), "--worlds",
+                                      str(worlds)])
+    code = 0
+    try:
+        cli.main()
+    except SystemExit as e:
+        code = int(e.code or 0)
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "tiny_room" in out and "(1.5, 1.5)" in out and "(4.5, 4.5)" in out
+    assert "total: 1 episodes in 1 stages, 0 obstacles, 1 pedestrians" in out
