@@ -39,7 +39,7 @@ import arena.maps.generators  # noqa: F401  (registers the generators)
 from arena.core.errors import ConfigError, from_validation_error
 from arena.maps.generators import MAP_GENERATORS
 from arena.maps.sources import MAP_SOURCES
-from arena.tasks.datafiles import find_data_file, read_yaml_any
+from arena.tasks.datafiles import find_data_file, read_arena_yaml
 
 ARENA_MAP_TYPES: dict[str, dict[str, str]] = {
     "rosnav": {"indoor": "rosnav_indoor", "outdoor": "rosnav_outdoor"},
@@ -213,4 +213,4 @@ def parse_curriculum(data: Any, *, source: str) -> Curriculum:
 def load_curriculum(name_or_path: str | Path) -> Curriculum:
     """Load a packaged curriculum (``"default"``, ``"semantic"``) or a curriculum file."""
     path = find_data_file("curricula", name_or_path)
-    return parse_curriculum(read_yaml_any(path), source=str(path))
+    return parse_curriculum(read_arena_yaml(path), source=str(path))

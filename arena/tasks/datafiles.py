@@ -2,7 +2,8 @@
 
 A file is named either by a packaged name (``"default"`` → ``data/curricula/default.yaml``) or
 by a path. :func:`read_yaml_any` reads any YAML document (curricula are lists) and reports
-malformed YAML with the file, line and column.
+malformed YAML with the file, line and column; :func:`read_arena_yaml` also reads the ROS 2
+port's parameter-file form of the same files.
 """
 
 from __future__ import annotations
@@ -52,3 +53,23 @@ def find_data_file(kind: Kind, name_or_path: str | Path) -> Path:
 def read_yaml_any(path: str | Path) -> Any:
     """Parse a YAML file of any shape; malformed YAML names the file, line and column."""
     return files.read_yaml(path)
+
+
+ROS2_PARAMS = "ros__parameters"
+"""The key of a ROS 2 parameter file's per-node block."""
+
+
+def read_arena_yaml(path: str | Path) -> Any:
+    """:func:`read_yaml_any` of an Arena task file, unwrapped from a ROS 2 parameter file.
+
+    Arena's ROS 2 port (its ``ros2``/``humble`` branches) stores the same suites, contests,
+    benchmark configs and curricula as ROS 2 parameter files: the document sits under
+    ``/**: ros__parameters:`` (or ``<node>: ros__parameters:``). A mapping whose only key
+    holds only ``ros__parameters`` is read as that block; any other document is returned as is.
+    """
+    data = read_yaml_any(path)
+    if isinstance(data, dict) and len(data) == 1:
+        (inner,) = data.values()
+        if isinstance(inner, dict) and set(inner) == {ROS2_PARAMS}:
+            return inner[ROS2_PARAMS]
+    return data

@@ -49,7 +49,7 @@ from arena.core.errors import ConfigError, from_validation_error
 from arena.core.names import RULE, SafeName
 from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, check_worlds_folder, resolve_world
-from arena.tasks.datafiles import find_data_file, read_yaml_any
+from arena.tasks.datafiles import find_data_file, read_arena_yaml
 from arena.tasks.suite_worlds import find_stage_world
 
 MAX_EPISODES = 1_000_000
@@ -515,7 +515,7 @@ def load_suite(
     """
     path = find_data_file("suites", name_or_path)
     source = str(path)
-    data = read_yaml_any(path)
+    data = read_arena_yaml(path)
     if not isinstance(data, dict):
         raise ConfigError(
             f"expected a mapping {{stages: [...]}}, got {type(data).__name__}", source=source
@@ -536,7 +536,7 @@ def load_suite(
 def load_contest(name_or_path: str | Path) -> tuple[ContestFile, str]:
     """Load a packaged contest (``"basic"``) or a contest file; returns it and its path."""
     path = find_data_file("contests", name_or_path)
-    data = read_yaml_any(path)
+    data = read_arena_yaml(path)
     return _validate(ContestFile, data, str(path)), str(path)
 
 
@@ -578,7 +578,7 @@ def load_benchmark(
     (the ``--worlds`` option) replaces ``suite.worlds``, which replaces the suite's own.
     """
     p = Path(path)
-    data = read_yaml_any(p)
+    data = read_arena_yaml(p)
     bench = _validate(BenchmarkFile, data, str(p))
 
     def find(folder: str, name: str) -> str:
