@@ -148,7 +148,7 @@ EXPECTED: tuple[tuple[str, str, str], ...] = (
     ("benchmark/arena-rosnav@humble/arena_bringup/configs/benchmark/config.yaml",
      "unknown intermediate planner 'navigate_w_replanning_time'",
      "its contest basic.yaml names the ROS 2 nav2 behaviour tree navigate_w_replanning_time"),
-    # -- curricula, zones ---------------------------------------------------------------------
+    # -- zones --------------------------------------------------------------------------------
     ("zones/arena-simulation-setup@tm_zones/*", "valid dictionary",
      "the tm_zones branch's older zone format (a bare list of groups)"),
 )
@@ -203,7 +203,7 @@ def _merged_worlds(corpus: Path, shared: Path | None, into: Path) -> Path:
     return into
 
 
-def _scenario_world(path: Path, corpus: Path, worlds: dict[str, Path]) -> tuple[Path | None, str]:
+def _scenario_world(path: Path, worlds: dict[str, Path]) -> tuple[Path | None, str]:
     """The world a scenario file runs on, and how it was found."""
     if path.parent.name == "scenarios" and path.parent.parent.parent.name == "worlds":
         name = path.parent.parent.name
@@ -222,7 +222,10 @@ def discover(corpus: Path, shared: Path | None) -> list[Item]:
     """Every file to check, in the report's order."""
     worlds = _world_folders(corpus, shared)
     items: list[Item] = []
-    rel = lambda p: p.relative_to(corpus).as_posix()  # noqa: E731
+
+    def rel(p: Path) -> str:
+        return p.relative_to(corpus).as_posix()
+
     for p in sorted(corpus.glob("worlds/**/*.yaml")):
         if p.name.endswith(".world.yaml"):
             continue
@@ -230,7 +233,7 @@ def discover(corpus: Path, shared: Path | None) -> list[Item]:
         target = (p.parent.parent if p.parent.name == "map" else p.parent) if in_world else p
         items.append(Item("map", rel(p), {"target": str(target), "world": in_world}))
     for p in sorted(corpus.glob("scenarios/**/*.json")):
-        world, how = _scenario_world(p, corpus, worlds)
+        world, how = _scenario_world(p, worlds)
         items.append(Item("scenario", rel(p), {"world": str(world) if world else None,
                                                "how": how}))
     bench = sorted(corpus.glob("benchmark/*/**/configs/benchmark"))
