@@ -138,6 +138,9 @@ def test_resolution_order(layout: tuple[Path, Path], tmp_path: Path) -> None:
     block = load_suite(f, worlds=worlds).stage_map(0, {})
     assert block == {"type": "world", "name": str(worlds.resolve() / "empty_room")}
     assert load_suite(f).stage_map(0, {}) == {"type": "world", "name": "empty_room"}
+    # a packaged world that DIR does not hold is still found
+    f = _suite_with_map(suite, "corridor")
+    assert load_suite(f, worlds=worlds).stage_map(0, {}) == {"type": "world", "name": "corridor"}
     # ... and over a world next to the suite (<suite dir>/../worlds/<name>)
     _world(suite.parent.parent / "worlds", "tiny_room", 8.0)
     f = _suite_with_map(suite, "tiny_room")
