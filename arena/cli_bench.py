@@ -158,7 +158,7 @@ def _print_bench_tables(results: object, title: str) -> None:
     import numpy as np
 
     from arena.eval import plots
-    from arena.eval.report import summary_table
+    from arena.eval.tables import summary_table
 
     cols = plots.as_columns(results)
     n = len(cols["contestant"])
