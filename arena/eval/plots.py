@@ -248,8 +248,9 @@ def _bars(ax: Any, pos: FloatArray, groups: Sequence[FloatArray], width: float, 
     err = np.zeros((2, len(est)))
     err[0, ok] = mean[ok] - np.array([e.lower for e in est])[ok]
     err[1, ok] = np.array([e.upper for e in est])[ok] - mean[ok]
-    ax.bar(pos[~low], mean[~low], width * 0.9, color=color, alpha=0.85, label=label,
-           edgecolor="black", linewidth=0.6)
+    if (~low).any():
+        ax.bar(pos[~low], mean[~low], width * 0.9, color=color, alpha=0.85, label=label,
+               edgecolor="black", linewidth=0.6)
     if low.any():
         ax.bar(pos[low], mean[low], width * 0.9, color=color, alpha=0.35, hatch=LOW_N_HATCH,
                edgecolor="black", linewidth=0.6, label=None if (~low).any() else label)
@@ -305,7 +306,8 @@ def plot_metric(
     stages = unique_in_order(cols["stage"]) if by_stage and "stage" in cols else [""]
     n_c, n_s = len(contestants), len(stages)
     width = 0.8 / n_s
-    fig = new_figure(max(4.0, 1.3 * n_c * max(1, n_s) ** 0.5 + 1.5), 3.6)
+    # about 0.4 in per bar: 4 planners x 4 stages fit a 7 in (two-column page) figure
+    fig = new_figure(min(9.0, max(4.0, 0.4 * n_c * n_s + 1.6)), 3.6)
     ax = fig.add_subplot()
     rng = np.random.default_rng(seed)
     per_stage = _groups(cols, metric, contestants, stages)
@@ -362,6 +364,7 @@ def plot_metric(
     ax.grid(axis="y", alpha=0.3)
     if kind == "bar" and np.nanmin(np.asarray(cols[metric], np.float64), initial=0.0) >= 0:
         ax.set_ylim(bottom=0.0)  # non-negative metric: the axis starts at zero
+        ax.set_ylim(top=ax.get_ylim()[1] * 1.08)  # room for the n labels above the bars
     handles, labels = ax.get_legend_handles_labels()
     if low_any:
         from matplotlib.patches import Patch
@@ -370,7 +373,7 @@ def plot_metric(
         labels.append(f"n < {MIN_N}: no interval")
     if handles:
         fig.legend(handles, labels, loc="outside lower center",
-                   ncols=min(len(handles), 4), fontsize="small", frameon=False)
+                   ncols=min(len(handles), 5), fontsize="small", frameon=False)
     save_figure(fig, path)
     return fig
 

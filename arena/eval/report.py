@@ -81,8 +81,10 @@ def _metric_images(
 ) -> list[str]:
     """The ``<img>`` tags of one metric's plots (a top-level function: it runs in workers)."""
     tags = []
+    # headline figures carry the tables' column names ("Time facing", not the metric's name)
+    title = dict(HEADLINE_METRICS)[metric].split(" [")[0] if prefix == "headline" else None
     for k in kinds:
-        fig = plots.plot_metric(table, metric, k, by_stage=by_stage)
+        fig = plots.plot_metric(table, metric, k, by_stage=by_stage, title=title)
         name = f"{prefix}_{metric}" if prefix == "headline" else f"{prefix}_{metric}_{k}"
         tags.append(_figure_tag(fig, f"{metric} {k}", figure_stem(fig_dir, name)))
     return tags

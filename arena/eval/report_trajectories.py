@@ -122,11 +122,11 @@ def stage_trajectories(
 
 
 #: Columns of the outcome table: (results column, header, format); missing columns are left out.
+#: The trajectory link follows ``episode``; the (long) seed comes last.
 OUTCOME_COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("contestant", "contestant", "{}"),
     ("stage", "stage", "{}"),
     ("episode", "episode", "{}"),
-    ("seed", "seed", "{}"),
+    ("contestant", "contestant", "{}"),
     ("outcome", "outcome", "{}"),
     ("time", "time [s]", "{:.1f}"),
     ("path_length", "path [m]", "{:.1f}"),
@@ -136,7 +136,9 @@ OUTCOME_COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("collisions_robot", "robots", "{:.0f}"),
     ("time_in_private_zone", "priv. zone [s]", "{:.1f}"),
     ("min_distance_to_person", "min gap [m]", "{:.2f}"),
+    ("seed", "seed", "{}"),
 )
+_TEXT = frozenset({"stage", "contestant", "outcome", "seed"})
 
 
 def anchor(stage: str, episode: int) -> str:
@@ -215,23 +217,33 @@ def episode_section(
 ) -> str:
     """The HTML outcome table (a row per episode and contestant) and the thumbnails it links.
 
-    Rows link to ``#<anchor>`` of their (stage, episode) thumbnail; a small script opens the
+    Rows are ordered by stage, episode and contestant (an episode's planners side by side) and
+    link to ``#<anchor>`` of their (stage, episode) thumbnail; a small script opens the
     collapsed section the thumbnail is in when the link is followed.
     """
     n = len(cols["contestant"])
     shown = [(k, h, f) for k, h, f in OUTCOME_COLUMNS if k in cols]
-    head = "".join(f"<th>{html.escape(h)}</th>" for _, h, _ in shown) + "<th></th>"
+    ths = [f'<th class="l">{html.escape(h)}</th>' if k in _TEXT else f"<th>{html.escape(h)}</th>"
+           for k, h, _ in shown]
+    at = next((j + 1 for j, (k, _, _) in enumerate(shown) if k == "episode"), len(shown))
+    ths.insert(at, "<th></th>")
     stage_col = cols["stage"] if "stage" in cols else np.full(n, "")
+    # rows of one episode together, planners in order: compare them on the same episode
+    stage_rank = {s: j for j, s in enumerate(plots.unique_in_order(stage_col))}
+    who_rank = {c: j for j, c in enumerate(plots.unique_in_order(cols["contestant"]))}
+    ep_col = cols["episode"] if "episode" in cols else np.zeros(n, int)
+    order = sorted(range(n), key=lambda i: (stage_rank[str(stage_col[i])], int(ep_col[i]),
+                                            who_rank[str(cols["contestant"][i])]))
     body = []
-    for i in range(n):
+    for i in order:
         key = (str(stage_col[i]), int(cols["episode"][i])) if "episode" in cols else None
-        tds = "".join(
-            f'<td class="l">{html.escape(_cell(cols[k][i], f))}</td>' if f == "{}"
-            else f"<td>{html.escape(_cell(cols[k][i], f))}</td>" for k, _, f in shown)
-        link = (f'<td><a href="#{anchor(*key)}">trajectory</a></td>'
-                if key is not None and key in thumbnails else "<td></td>")
+        tds = [f'<td class="l">{html.escape(_cell(cols[k][i], f))}</td>' if k in _TEXT
+               else f"<td>{html.escape(_cell(cols[k][i], f))}</td>" for k, _, f in shown]
+        tds.insert(at, f'<td class="l"><a href="#{anchor(*key)}">trajectory</a></td>'
+                   if key is not None and key in thumbnails else "<td></td>")
         cls = str(cols["outcome"][i]) if "outcome" in cols else ""
-        body.append(f'<tr class="o-{html.escape(cls)}">{tds}{link}</tr>')
+        body.append(f'<tr class="o-{html.escape(cls)}">{"".join(tds)}</tr>')
+    head = "".join(ths)
     missing = ""
     if "episode" in cols:
         pairs = {(str(stage_col[i]), int(cols["episode"][i])) for i in range(n)}
