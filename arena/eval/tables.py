@@ -202,15 +202,25 @@ def _caption(params: Any, what: str) -> str:
     rule = ("goal reached, fewer than 2 collisions (Arena 3.0 paper)" if p.success_rule == "arena"
             else "goal reached, collisions allowed")
     return (
-        f"{what}: mean$^{{+u}}_{{-l}}$ over episodes, $[\\mathrm{{mean}}-l, \\mathrm{{mean}}+u]$ "
-        f"its 95\\,\\% percentile-bootstrap interval ({RESAMPLES} resamples); $n$: episodes "
-        f"per planner; $^{{\\dagger}}$: fewer than {MIN_N} values, no interval; "
+        f"{what}: mean over episodes with its 95\\,\\% percentile-bootstrap interval "
+        f"({RESAMPLES} resamples), written mean$^{{+u}}_{{-l}}$ for the interval "
+        f"$[\\mathrm{{mean}}-l, \\mathrm{{mean}}+u]$; $n$: episodes per planner; $^{{\\dagger}}$: "
+        f"fewer than {MIN_N} values, no interval; "
         r"($n{=}k$): the cell's own number of values where it differs (time to goal counts "
         f"successful episodes only). Success: {rule}. Private zone: time with a person's body "
         f"closer than {p.private_zone_radius:g}\\,m to the robot's body; personal-space radius "
         f"{p.personal_space_radius:g}\\,m (Hall). Time seen / facing: a person faced the robot "
         "/ the robot faced a person."
     )
+
+
+def _stage_caption(params: Any) -> str:
+    from arena.eval.metrics import MetricParams
+
+    p = params if params is not None else MetricParams()
+    return (r"Per stage; notation as in Table~\ref{tab:arena-overall} ($^{\dagger}$: fewer than "
+            f"{MIN_N} values, no interval; private zone {p.private_zone_radius:g}\\,m, "
+            f"personal-space radius {p.personal_space_radius:g}\\,m).")
 
 
 def latex_tables(table: Any, params: Any = None) -> str:
@@ -269,7 +279,7 @@ def latex_tables(table: Any, params: Any = None) -> str:
             body.append(r"\midrule")
         body.append(rf"\multicolumn{{{ncol}}}{{l}}{{\textit{{{tex_escape(s or 'all')}}}}} \\")
         body += _tex_rows(rows, s, contestants, episodes, digits)
-    lines += float_("tab:arena-stages", _caption(params, "Per stage"), body)
+    lines += float_("tab:arena-stages", _stage_caption(params), body)
     return "\n".join(lines)
 
 
