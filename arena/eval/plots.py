@@ -315,7 +315,7 @@ def plot_metric(
     low_any = False
     for j, (stage, groups) in enumerate(zip(stages, per_stage, strict=True)):
         color = COLORS[j % len(COLORS)]
-        pos = np.arange(n_c) + (j - (n_s - 1) / 2.0) * width
+        pos: FloatArray = np.arange(n_c, dtype=np.float64) + (j - (n_s - 1) / 2.0) * width
         label = stage or None
         if kind == "bar":
             low_any |= _bars(ax, pos, groups, width, color, label, show_n=len(sizes) > 1)[1]
