@@ -219,6 +219,7 @@ def _write_report(run: Path, out: Path | None, *, videos: int, workers: int) -> 
         paths = write_run_report(run, out, video_episodes=videos, workers=workers)
     for kind in ("html", "csv", "tex"):
         console.print(f"{kind + ':':6} {paths[kind]}")
+    console.print(f"figures: {paths['figures']} (PDF and SVG)")
 
 
 def report(

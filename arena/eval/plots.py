@@ -271,7 +271,7 @@ def _bars(ax: Any, pos: FloatArray, groups: Sequence[FloatArray], width: float, 
 def plot_metric(
     table: Any,
     metric: str,
-    kind: PlotKind = "box",
+    kind: PlotKind | Sequence[PlotKind] = "box",
     *,
     by_stage: bool = False,
     path: str | Path | None = None,
@@ -288,29 +288,76 @@ def plot_metric(
     Args:
         table: the results table.
         metric: metric column.
-        kind: ``bar``, ``box``, ``violin`` or ``strip`` (jittered points).
+        kind: ``bar``, ``box``, ``violin`` or ``strip`` (jittered points), or several kinds:
+            one panel each, side by side in one figure (one legend).
         by_stage: group each contestant's bars by stage (one colour per stage).
         path: save the figure here (format from the suffix).
         seed: seed of the strip-plot jitter (deterministic output).
-        title: figure title (default: the metric's name and the kind).
+        title: figure title (default: the metric's name, and the kind for a lone non-bar plot).
 
     Returns:
-        The figure.
+        The figure (``fig.axes``: one panel per kind).
     """
-    if kind not in PLOT_KINDS:
-        raise ValueError(f"unknown plot kind {kind!r}; choose from {PLOT_KINDS}")
+    kinds: tuple[PlotKind, ...] = (kind,) if isinstance(kind, str) else tuple(kind)
+    for k in kinds:
+        if k not in PLOT_KINDS:
+            raise ValueError(f"unknown plot kind {k!r}; choose from {PLOT_KINDS}")
     cols = as_columns(table)
     if metric not in cols:
         raise KeyError(f"metric {metric!r} not in the results table")
     contestants = unique_in_order(cols["contestant"])
     stages = unique_in_order(cols["stage"]) if by_stage and "stage" in cols else [""]
     n_c, n_s = len(contestants), len(stages)
-    width = 0.8 / n_s
     # about 0.4 in per bar: 4 planners x 4 stages fit a 7 in (two-column page) figure
-    fig = new_figure(min(9.0, max(4.0, 0.4 * n_c * n_s + 1.6)), 3.6)
-    ax = fig.add_subplot()
-    rng = np.random.default_rng(seed)
+    panel_w = min(9.0, max(4.0, 0.4 * n_c * n_s + 1.6))
+    fig = new_figure(panel_w if len(kinds) == 1 else min(14.0, 0.7 * panel_w * len(kinds)), 3.6)
+    axes = fig.subplots(1, len(kinds), squeeze=False)[0]
     per_stage = _groups(cols, metric, contestants, stages)
+    rng = np.random.default_rng(seed)
+    low_any = False
+    name = metric_label(metric).split(" [")[0]
+    for ax, k in zip(axes, kinds, strict=True):
+        low_any |= _draw_kind(ax, k, per_stage, contestants, stages, rng)
+        ax.set_ylabel(metric_label(metric))
+        sizes = {g.size for groups in per_stage for g in groups if g.size}
+        sub = ""
+        if k == "bar":
+            sub = (f"mean, 95 % bootstrap interval; n = {next(iter(sizes))} episodes per bar"
+                   if len(sizes) == 1 else "mean, 95 % bootstrap interval; n above each bar")
+        elif len(sizes) == 1:
+            sub = f"{k}, n = {next(iter(sizes))} episodes per group" if len(kinds) > 1 else (
+                f"n = {next(iter(sizes))} episodes per group")
+        elif len(kinds) > 1:
+            sub = k
+        if len(kinds) > 1:
+            ax.set_title(sub, fontsize="medium")
+        else:
+            head = title if title is not None else (name if k == "bar" else f"{name} ({k})")
+            ax.set_title(f"{head}\n{sub}" if sub else head, fontsize="medium")
+        if k == "bar" and np.nanmin(np.asarray(cols[metric], np.float64), initial=0.0) >= 0:
+            ax.set_ylim(bottom=0.0)  # non-negative metric: the axis starts at zero
+            ax.set_ylim(top=ax.get_ylim()[1] * 1.08)  # room for the n labels above the bars
+    if len(kinds) > 1:
+        fig.suptitle(title if title is not None else name)
+    handles, labels = axes[0].get_legend_handles_labels()
+    if low_any:
+        from matplotlib.patches import Patch
+
+        handles.append(Patch(facecolor="white", edgecolor="black", hatch=LOW_N_HATCH))
+        labels.append(f"n < {MIN_N}: no interval")
+    if handles:
+        fig.legend(handles, labels, loc="outside lower center",
+                   ncols=min(len(handles), 5), fontsize="small", frameon=False)
+    save_figure(fig, path)
+    return fig
+
+
+def _draw_kind(ax: Any, kind: PlotKind, per_stage: Sequence[Sequence[FloatArray]],
+               contestants: Sequence[str], stages: Sequence[str],
+               rng: np.random.Generator) -> bool:
+    """Draw one panel of :func:`plot_metric`; True if a bar was low-n."""
+    n_c, n_s = len(contestants), len(stages)
+    width = 0.8 / n_s
     sizes = {g.size for groups in per_stage for g in groups if g.size}
     low_any = False
     for j, (stage, groups) in enumerate(zip(stages, per_stage, strict=True)):
@@ -334,7 +381,7 @@ def plot_metric(
             if keep:
                 vp = ax.violinplot([_jitter_const(groups[i]) for i in keep], positions=pos[keep],
                                    widths=width * 0.9, showmeans=False, showmedians=True)
-                for body in vp["bodies"]:  # type: ignore[attr-defined]
+                for body in vp["bodies"]:
                     body.set_facecolor(color)
                     body.set_edgecolor("black")
                     body.set_alpha(0.6)
@@ -351,31 +398,8 @@ def plot_metric(
                            label=label if p == pos[0] else None)
     ax.set_xticks(np.arange(n_c), contestants, rotation=20 if n_c > 4 else 0)
     ax.set_xlim(-0.6, n_c - 0.4)
-    ax.set_ylabel(metric_label(metric))
-    name = metric_label(metric).split(" [")[0]
-    head = title if title is not None else (name if kind == "bar" else f"{name} ({kind})")
-    sub = ""
-    if kind == "bar":
-        sub = (f"mean, 95 % bootstrap interval; n = {next(iter(sizes))} episodes per bar"
-               if len(sizes) == 1 else "mean, 95 % bootstrap interval; n above each bar")
-    elif len(sizes) == 1:
-        sub = f"n = {next(iter(sizes))} episodes per group"
-    ax.set_title(f"{head}\n{sub}" if sub else head, fontsize="medium")
     ax.grid(axis="y", alpha=0.3)
-    if kind == "bar" and np.nanmin(np.asarray(cols[metric], np.float64), initial=0.0) >= 0:
-        ax.set_ylim(bottom=0.0)  # non-negative metric: the axis starts at zero
-        ax.set_ylim(top=ax.get_ylim()[1] * 1.08)  # room for the n labels above the bars
-    handles, labels = ax.get_legend_handles_labels()
-    if low_any:
-        from matplotlib.patches import Patch
-
-        handles.append(Patch(facecolor="white", edgecolor="black", hatch=LOW_N_HATCH))
-        labels.append(f"n < {MIN_N}: no interval")
-    if handles:
-        fig.legend(handles, labels, loc="outside lower center",
-                   ncols=min(len(handles), 5), fontsize="small", frameon=False)
-    save_figure(fig, path)
-    return fig
+    return low_any
 
 
 def _jitter_const(g: FloatArray) -> FloatArray:

@@ -7,7 +7,7 @@ metric; every other metric follows in a collapsible section, then the radar char
 trajectories, the per-episode outcome table (rows link to each episode's trajectory) and the
 videos. Figures are embedded as base64 PNGs (the page can be mailed or archived alone) and also
 saved as PDF and SVG under ``figures/`` beside the page (stable names: ``headline_<metric>``,
-``metric_<metric>_<kind>``, ``radar``, ``trajectories_<stage>``). :func:`main` is the entry
+``metric_<metric>``, ``radar``, ``trajectories_<stage>``). :func:`main` is the entry
 point behind ``arena report RUN``; the tables come from :mod:`arena.eval.tables`.
 """
 
@@ -79,15 +79,12 @@ def _metric_images(
     table: Any, metric: str, kinds: Sequence[plots.PlotKind], by_stage: bool,
     fig_dir: Path | None, prefix: str,
 ) -> list[str]:
-    """The ``<img>`` tags of one metric's plots (a top-level function: it runs in workers)."""
-    tags = []
+    """The ``<img>`` tag of one metric's figure, one panel per kind (runs in workers)."""
     # headline figures carry the tables' column names ("Time facing", not the metric's name)
     title = dict(HEADLINE_METRICS)[metric].split(" [")[0] if prefix == "headline" else None
-    for k in kinds:
-        fig = plots.plot_metric(table, metric, k, by_stage=by_stage, title=title)
-        name = f"{prefix}_{metric}" if prefix == "headline" else f"{prefix}_{metric}_{k}"
-        tags.append(_figure_tag(fig, f"{metric} {k}", figure_stem(fig_dir, name)))
-    return tags
+    fig = plots.plot_metric(table, metric, kinds, by_stage=by_stage, title=title)
+    return [_figure_tag(fig, f"{metric} {', '.join(kinds)}",
+                        figure_stem(fig_dir, f"{prefix}_{metric}"))]
 
 
 def _all_metric_images(
@@ -240,10 +237,11 @@ def write_report(
     Sections: run info; **results**: the headline tables (overall and per stage) and one
     grouped-bar figure per headline metric (mean, bootstrap interval, n; planners on the x
     axis, one colour per stage); **all metrics**: a collapsible table and, per other metric, a
-    collapsible block with its ``kinds`` plots; the social radar chart (fixed ranges); one
-    trajectory figure per stage (see :func:`stage_trajectories`); the **episodes** table, each
-    row linking to its episode's trajectory thumbnail (at most ``episode_figures``); the
-    ``videos`` (MP4) embedded as base64, each with its last frame as poster.
+    collapsible block with one figure, a panel per plot kind in ``kinds``; the social radar
+    chart (fixed ranges); one trajectory figure per stage (see :func:`stage_trajectories`);
+    the **episodes** table, each row linking to its episode's trajectory thumbnail (at most
+    ``episode_figures``); the ``videos`` (MP4) embedded as base64, each with its last frame as
+    poster.
 
     Args:
         table: the results table.

@@ -229,3 +229,13 @@ def test_blank_panels_without_grids_and_ranges():
     assert not fig.axes[0].images
     assert trajectory_plots.trajectory_panels({}, {}) == ([], "")
     assert trajectory_plots.episode_ranges([0, 1, 2, 5, 7, 8]) == "0–2, 5, 7–8"
+
+
+def test_several_kinds_share_one_figure_and_legend():
+    fig = plots.plot_metric(build_table(), "path_length", ("bar", "box"), by_stage=True)
+    assert [ax.get_title() for ax in fig.axes] == ["mean, 95 % bootstrap interval; n = 5 "
+                                                   "episodes per bar", "box, n = 5 episodes "
+                                                   "per group"]
+    assert fig.get_suptitle() == "Path length" and len(fig.legends) == 1
+    with pytest.raises(ValueError, match="unknown plot kind 'pie'"):
+        plots.plot_metric(build_table(), "path_length", ("bar", "pie"))  # type: ignore[arg-type]

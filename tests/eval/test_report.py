@@ -39,9 +39,9 @@ def test_write_report_self_contained(tmp_path):
     srcs = re.findall(r'src="([^"]*)"', text)
     assert srcs and all(s.startswith("data:") for s in srcs)
     n_png = sum(s.startswith("data:image/png;base64,") for s in srcs)
-    # 7 metrics: 5 headline (a bar figure each), 2 others (bar + box), radar, one trajectory
-    # figure per stage, one thumbnail per (stage, episode)
-    assert n_png == 5 + 2 * 2 + 1 + 2 + 2 * 5
+    # 7 metrics: 5 headline (a bar figure each), 2 others (one figure each: bar and box
+    # panels), radar, one trajectory figure per stage, one thumbnail per (stage, episode)
+    assert n_png == 5 + 2 + 1 + 2 + 2 * 5
     assert any(s.startswith("data:video/mp4;base64,") for s in srcs)
     for c in CONTESTANTS:
         assert c in text
@@ -55,11 +55,11 @@ def test_write_report_self_contained(tmp_path):
                      results)
     # every figure also as PDF and SVG, stable names
     figs = out.parent / "figures"
-    for stem in ("headline_success", "headline_collisions", "metric_min_distance_to_person_box",
+    for stem in ("headline_success", "headline_collisions", "metric_min_distance_to_person",
                  "radar", "trajectories_easy"):
         assert (figs / f"{stem}.pdf").read_bytes().startswith(b"%PDF")
         assert ET.parse(figs / f"{stem}.svg").getroot().tag.endswith("svg")
-    assert len(list(figs.glob("*.pdf"))) == len(list(figs.glob("*.svg"))) == 5 + 4 + 1 + 2
+    assert len(list(figs.glob("*.pdf"))) == len(list(figs.glob("*.svg"))) == 5 + 2 + 1 + 2
     # the episode table: one row per episode and contestant, each linking to its trajectory
     links = re.findall(r'<a href="#(ep-[^"]+)">trajectory</a>', text)
     assert len(links) == 20 and set(links) == {f"ep-{s}-{i}" for s in ("easy", "hard")
