@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import base64
 import html
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -31,7 +31,15 @@ from arena.eval.report_trajectories import (
     stage_trajectories,
 )
 from arena.eval.stats import MIN_N, RESAMPLES
-from arena.eval.tables import ALL_STAGES, SummaryRow, decimals, fmt, summary_table, write_tables
+from arena.eval.tables import (
+    ALL_STAGES,
+    SummaryRow,
+    decimals,
+    episode_counts,
+    fmt,
+    summary_table,
+    write_tables,
+)
 from arena.eval.trajectory_plots import plot_stage_trajectories
 
 _CSS = """
@@ -118,12 +126,14 @@ def _cell_html(r: SummaryRow | None, digits: int, n_rows: int) -> str:
 
 
 def summary_html(rows: Sequence[SummaryRow], metrics: Sequence[str],
-                 headers: Sequence[str] | None = None, *, by: str = "stage") -> str:
-    """One table per stage (``by="stage"``: a row per contestant, a column per metric).
+                 episodes: Mapping[tuple[str, str], int],
+                 headers: Sequence[str] | None = None) -> str:
+    """One table per stage: a row per contestant, a column per metric, ``mean [lower, upper]``.
 
     ``rows`` come from :func:`~arena.eval.tables.summary_table` (with ``overall=True`` the
-    :data:`~arena.eval.tables.ALL_STAGES` table comes first); each table's column keeps one
-    number of decimals; ``n`` is the contestant's episodes on the stage.
+    :data:`~arena.eval.tables.ALL_STAGES` table comes first); each column keeps one number of
+    decimals; ``n`` is the contestant's episodes on the stage
+    (:func:`~arena.eval.tables.episode_counts`), a cell with fewer values shows its own n.
     """
     stages = list(dict.fromkeys(r.stage for r in rows))
     if ALL_STAGES in stages:
@@ -139,7 +149,7 @@ def summary_html(rows: Sequence[SummaryRow], metrics: Sequence[str],
         contestants = list(dict.fromkeys(r.contestant for r in sub))
         body = []
         for c in contestants:
-            n_rows = max((r.n for r in sub if r.contestant == c), default=0)
+            n_rows = episodes.get((c, stage), 0)
             tds = "".join(_cell_html(cell.get((c, m)), digits[m], n_rows) for m in metrics)
             body.append(f"<tr><td>{html.escape(c)}</td><td>{n_rows}</td>{tds}</tr>")
         title = "all stages" if stage == ALL_STAGES else stage
@@ -275,11 +285,12 @@ def write_report(
     parts = [f"<h1>{html.escape(title)}</h1>", _run_info(run_dir, cols, contestants, stages)]
 
     plotted = [m for m in names if np.isfinite(np.asarray(cols[m], np.float64)).any()]
+    counts = episode_counts(cols)
     head = [(m, h) for m, h in HEADLINE_METRICS if m in plotted]
     parts.append("<h2>Results</h2>" + _note(params))
     if head:
         rows = summary_table(cols, [m for m, _ in head], overall=by_stage)
-        parts.append(summary_html(rows, [m for m, _ in head], [h for _, h in head]))
+        parts.append(summary_html(rows, [m for m, _ in head], counts, [h for _, h in head]))
         images = _all_metric_images(table, [m for m, _ in head], ("bar",), by_stage, workers,
                                     fig_dir, "headline")
         parts.append('<div class="figs">' + "".join(t for tags in images for t in tags)
@@ -289,7 +300,7 @@ def write_report(
     if plotted:
         rows = summary_table(cols, plotted, overall=by_stage)
         parts.append("<h2>All metrics</h2><details><summary>Table of every metric (mean "
-                     "[interval])</summary>" + summary_html(rows, plotted) + "</details>")
+                     "[interval])</summary>" + summary_html(rows, plotted, counts) + "</details>")
     images = _all_metric_images(table, others, kinds, by_stage, workers, fig_dir, "metric")
     for m, figs in zip(others, images, strict=True):
         parts.append(f"<details><summary>{html.escape(plots.metric_label(m))}</summary>"

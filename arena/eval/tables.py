@@ -97,6 +97,18 @@ def summary_table(
     return rows
 
 
+def episode_counts(table: Any) -> dict[tuple[str, str], int]:
+    """Episodes (rows, whatever their values) per ``(contestant, stage)`` and ``ALL_STAGES``."""
+    cols = plots.as_columns(table)
+    who = cols["contestant"]
+    stage_col = cols["stage"] if "stage" in cols else np.full(len(who), "")
+    out: dict[tuple[str, str], int] = {}
+    for c, s in zip(who, stage_col, strict=True):
+        for key in ((str(c), str(s)), (str(c), ALL_STAGES)):
+            out[key] = out.get(key, 0) + 1
+    return out
+
+
 def decimals(values: Sequence[float]) -> int:
     """Decimals that give the largest finite ``|value|`` about 3 significant digits (0 to 3).
 
@@ -243,12 +255,7 @@ def latex_tables(table: Any, params: Any = None) -> str:
     rows = summary_table(cols, names, overall=True)
     contestants = plots.unique_in_order(cols["contestant"])
     stages = plots.unique_in_order(cols["stage"])
-    episodes: dict[tuple[str, str], int] = {}
-    for c in contestants:
-        mine = cols["contestant"] == c
-        episodes[(c, ALL_STAGES)] = int(mine.sum())
-        for s in stages:
-            episodes[(c, s)] = int((mine & (cols["stage"] == s)).sum())
+    episodes = episode_counts(cols)
     digits = {m: decimals([v for r in rows if r.metric == m for v in (r.mean, r.upper)])
               for m in names}
     ncol = 2 + len(names)
@@ -283,5 +290,5 @@ def latex_tables(table: Any, params: Any = None) -> str:
     return "\n".join(lines)
 
 
-__all__ = ["ALL_STAGES", "SummaryRow", "decimals", "fmt", "latex_tables", "summary_table",
-           "tex_escape", "write_tables"]
+__all__ = ["ALL_STAGES", "SummaryRow", "decimals", "episode_counts", "fmt", "latex_tables",
+           "summary_table", "tex_escape", "write_tables"]

@@ -125,3 +125,17 @@ def test_trajectory_maps_are_rebuilt_from_the_records(tmp_path):
     assert panels[0].grid != panels[1].grid and "per episode" in note
     panels, note = stage_trajectories(cols, tmp_path, "s", max_episodes=1)
     assert len(panels) == 1 and note == "episodes 0 of 2 shown, one map"
+
+
+def test_summary_html_n_is_episodes_and_cells_with_fewer_values_say_so():
+    from arena.eval.tables import episode_counts, summary_table
+
+    cols = {"contestant": np.array(["a"] * 6), "stage": np.array(["s"] * 6),
+            "time_to_goal": np.array([5.0, 6.0, np.nan, 7.0, 5.5, 6.5]),  # 1 failure
+            "success": np.array([1.0, 1.0, 0.0, 1.0, 1.0, 1.0])}
+    counts = episode_counts(cols)
+    assert counts == {("a", "s"): 6, ("a", "(all)"): 6}
+    text = report.summary_html(summary_table(cols), ["time_to_goal", "success"], counts)
+    assert "<td>a</td><td>6</td>" in text
+    assert re.search(r'<td>6\.00 <span class="iv">\[[\d.]+, [\d.]+\]</span> '
+                     r'<span class="iv">n=5</span></td>', text)
