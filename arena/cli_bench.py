@@ -167,7 +167,7 @@ def _print_bench_tables(results: object, title: str) -> None:
     import numpy as np
 
     from arena.eval import plots
-    from arena.eval.report import summary_table
+    from arena.eval.tables import summary_table
 
     cols = plots.as_columns(results)
     n = len(cols["contestant"])
@@ -228,6 +228,7 @@ def _write_report(run: Path, out: Path | None, *, videos: int, workers: int) -> 
         paths = write_run_report(run, out, video_episodes=videos, workers=workers)
     for kind in ("html", "csv", "tex"):
         console.print(f"{kind + ':':6} {paths[kind]}")
+    console.print(f"figures: {paths['figures']} (PDF and SVG)")
 
 
 def report(

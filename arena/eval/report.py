@@ -1,21 +1,21 @@
-"""Benchmark reports: summary statistics, CSV/LaTeX tables and one self-contained HTML file.
+"""Benchmark reports: one self-contained HTML file, the tables and every figure as PDF and SVG.
 
-:func:`summary_table` reduces the per-episode results table (see :mod:`arena.eval.plots`) to the
-mean and its 95 % confidence interval (Student t) per contestant × stage × metric;
-:func:`write_tables` writes that as CSV and as a booktabs LaTeX table; :func:`write_report`
-writes a single HTML file with the run info, the summary table and every figure embedded as a
-base64 PNG (and optional base64 MP4 videos), so it can be mailed or archived alone.
-:func:`main` is the entry point behind ``arena report RUN``.
+:func:`write_report` writes a single HTML page that leads with the paper's view: the headline
+tables (planners × :data:`~arena.eval.plots.HEADLINE_METRICS`, overall and per stage, mean with
+its bootstrap interval and n, :mod:`arena.eval.stats`) and one grouped-bar figure per headline
+metric; every other metric follows in a collapsible section, then the radar chart, the
+trajectories, the per-episode outcome table (rows link to each episode's trajectory) and the
+videos. Figures are embedded as base64 PNGs (the page can be mailed or archived alone) and also
+saved as PDF and SVG under ``figures/`` beside the page (stable names: ``headline_<metric>``,
+``metric_<metric>``, ``radar``, ``trajectories_<stage>``). :func:`main` is the entry
+point behind ``arena report RUN``; the tables come from :mod:`arena.eval.tables`.
 """
 
 from __future__ import annotations
 
 import base64
-import csv
 import html
-import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -23,208 +23,139 @@ from typing import Any
 import numpy as np
 
 from arena.eval import plots
-from arena.eval.record import EpisodeRecord
+from arena.eval.plots import HEADLINE_METRICS
+from arena.eval.report_trajectories import (
+    OPEN_TARGET_JS,
+    episode_section,
+    episode_thumbnails,
+    stage_trajectories,
+)
+from arena.eval.stats import MIN_N, RESAMPLES
+from arena.eval.tables import (
+    ALL_STAGES,
+    SummaryRow,
+    decimals,
+    episode_counts,
+    fmt,
+    summary_table,
+    write_tables,
+)
+from arena.eval.trajectory_plots import plot_stage_trajectories
 
-
-@dataclass(frozen=True)
-class SummaryRow:
-    """Mean of one metric for one contestant on one stage.
-
-    Attributes:
-        contestant, stage, metric: the group.
-        unit: the metric's unit from the registry ("" if unregistered).
-        n: number of finite values.
-        mean: their mean (NaN if ``n == 0``).
-        ci: half-width of the 95 % CI, ``t_{0.975, n-1} · s / √n`` (NaN if ``n < 2``).
-    """
-
-    contestant: str
-    stage: str
-    metric: str
-    unit: str
-    n: int
-    mean: float
-    ci: float
-
-    @property
-    def lower(self) -> float:
-        """Lower CI bound."""
-        return self.mean - self.ci
-
-    @property
-    def upper(self) -> float:
-        """Upper CI bound."""
-        return self.mean + self.ci
-
-
-def _unit(metric: str) -> str:
-    from arena.eval.metrics import METRICS
-
-    return METRICS.get(metric).unit if metric in METRICS else ""
-
-
-def summary_table(
-    table: Any, metrics: Sequence[str] | None = None, confidence: float = 0.95
-) -> list[SummaryRow]:
-    """Mean ± CI per contestant × stage × metric, contestants and stages in order of appearance.
-
-    Args:
-        table: the results table (pyarrow Table or mapping of arrays).
-        metrics: metric columns; ``None`` = every float non-key column.
-        confidence: CI level (default 95 %).
-    """
-    cols = plots.as_columns(table)
-    names = list(metrics) if metrics is not None else plots.metric_columns(cols)
-    contestants = plots.unique_in_order(cols["contestant"])
-    stage_col = cols["stage"] if "stage" in cols else np.full(len(cols["contestant"]), "")
-    stages = plots.unique_in_order(stage_col)
-    rows: list[SummaryRow] = []
-    for c in contestants:
-        for s in stages:
-            mask = (cols["contestant"] == c) & (stage_col == s)
-            if not mask.any():
-                continue
-            for m in names:
-                mean, ci, n = plots.mean_ci(np.asarray(cols[m], np.float64)[mask], confidence)
-                rows.append(SummaryRow(c, s, m, _unit(m), n, mean, ci))
-    return rows
-
-
-def _fmt(x: float, digits: int = 3) -> str:
-    return "–" if not math.isfinite(x) else f"{x:.{digits}g}" if abs(x) >= 1000 else (
-        f"{x:.{digits}f}")
-
-
-def _tex(text: str) -> str:
-    for a, b in (("\\", r"\textbackslash{}"), ("_", r"\_"), ("&", r"\&"), ("%", r"\%"),
-                 ("#", r"\#"), ("$", r"\$"), ("{", r"\{"), ("}", r"\}")):
-        text = text.replace(a, b)
-    return text
-
-
-def latex_table(rows: Sequence[SummaryRow], caption: str = "Benchmark results") -> str:
-    """A booktabs LaTeX table, one line per row: metric, unit, contestant, stage, n, mean ± CI."""
-    lines = [
-        r"\begin{table}[htbp]",
-        r"\centering",
-        rf"\caption{{{_tex(caption)}, mean $\pm$ 95\,\% CI}}",
-        r"\begin{tabular}{lllrr}",
-        r"\toprule",
-        r"Metric & Contestant & Stage & $n$ & Mean $\pm$ CI \\",
-        r"\midrule",
-    ]
-    last = None
-    for r in rows:
-        if last is not None and r.metric != last:
-            lines.append(r"\addlinespace")
-        last = r.metric
-        unit = f" [{_tex(r.unit)}]" if r.unit not in ("", "1", "-") else ""
-        ci = f" $\\pm$ {_fmt(r.ci)}" if math.isfinite(r.ci) else ""
-        lines.append(f"{_tex(r.metric)}{unit} & {_tex(r.contestant)} & {_tex(r.stage)} & "
-                     f"{r.n} & {_fmt(r.mean)}{ci} \\\\")
-    lines += [r"\bottomrule", r"\end{tabular}", r"\end{table}", ""]
-    return "\n".join(lines)
-
-
-def write_tables(table: Any, out: str | Path) -> tuple[Path, Path]:
-    """Write ``summary.csv`` and ``summary.tex`` (booktabs, mean ± CI) into the folder ``out``.
-
-    Returns:
-        The CSV and LaTeX paths.
-    """
-    from arena.core.files import make_dir
-
-    out = make_dir(out, what="report folder")
-    rows = summary_table(table)
-    csv_path, tex_path = out / "summary.csv", out / "summary.tex"
-    with csv_path.open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(["contestant", "stage", "metric", "unit", "n", "mean", "ci95", "lower",
-                    "upper"])
-        for r in rows:
-            w.writerow([r.contestant, r.stage, r.metric, r.unit, r.n, repr(r.mean), repr(r.ci),
-                        repr(r.lower), repr(r.upper)])
-    tex_path.write_text(latex_table(rows))
-    return csv_path, tex_path
-
-
-# -- HTML ------------------------------------------------------------------------------------------
 _CSS = """
 body{font-family:system-ui,'DejaVu Sans',sans-serif;margin:2em auto;max-width:1200px;
 padding:0 1em;color:#222;line-height:1.35}
 h1{border-bottom:2px solid #444}h2{margin-top:1.6em;border-bottom:1px solid #ccc}
-.scroll{overflow-x:auto;max-width:100%}
+.scroll{overflow-x:auto;max-width:100%}.tall{max-height:36em;overflow-y:auto}
 table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0 1em}
 th,td{padding:2px 10px;border-bottom:1px solid #ddd;text-align:right;white-space:nowrap}
-th:first-child,td:first-child,td.l{text-align:left}th{background:#f0f0f0}
-td.l{white-space:normal;word-break:break-all}
+th:first-child,td:first-child,td.l{text-align:left}th{background:#f0f0f0;position:sticky;top:0}
+td.l{white-space:normal}td.info{word-break:break-all}
+.iv{color:#666;font-size:0.9em}.lown{color:#b35900}caption{text-align:left;color:#555;
+font-size:0.9em;caption-side:bottom;padding-top:0.3em}
+tr.o-collision td,tr.o-timeout td,tr.o-error td{background:#fff4f0}
 .figs{display:grid;grid-template-columns:repeat(auto-fill,minmax(520px,1fr));gap:8px}
 .figs img{width:100%;height:auto;border:1px solid #ddd}
+.thumbs{display:flex;flex-wrap:wrap;gap:8px}.thumbs figure{margin:0}
+.thumbs figure:target img{outline:3px solid #e08000}
 .traj img,.wide img{display:block;max-width:100%;height:auto;margin:0 auto 1.5em}
 details{margin:0.3em 0}summary{cursor:pointer;font-weight:bold;font-size:1.05em;
 padding:0.3em 0}
-.vids{display:flex;flex-wrap:wrap;gap:12px}.vids figure{margin:0}
-video{max-width:560px;width:100%;background:#000}figcaption{font-size:0.85em;color:#555}
+.vids{display:flex;flex-wrap:wrap;gap:12px}.vids figure{margin:0;width:100%;max-width:960px}
+video{width:100%;min-width:min(720px,100%);background:#000}
+figcaption{font-size:0.85em;color:#555}
 """
 
-#: Metrics whose figures are expanded in the HTML report (the others are collapsed).
-OPEN_METRICS: tuple[str, ...] = ("success", "collisions", "time_to_goal", "path_length", "spl",
-                                 "personal_space_compliance", "cf_displacement_mean")
 
-
-def _img(fig: Any, alt: str) -> str:
+def _figure_tag(fig: Any, alt: str, stem: Path | None) -> str:
+    """The ``<img>`` tag (base64 PNG) of ``fig``; also saves ``stem.pdf`` and ``stem.svg``."""
+    if stem is not None:
+        plots.save_formats(fig, stem)
     data = base64.b64encode(plots.figure_png(fig)).decode("ascii")
     return f'<img alt="{html.escape(alt)}" src="data:image/png;base64,{data}">'
 
 
+def figure_stem(fig_dir: Path | None, name: str) -> Path | None:
+    """``fig_dir / name`` with characters outside ``A-Za-z0-9._-`` replaced by ``_``."""
+    if fig_dir is None:
+        return None
+    safe = "".join(ch if ch.isalnum() or ch in "._-" else "_" for ch in name)
+    return fig_dir / safe
+
+
 def _metric_images(
-    table: Any, metric: str, kinds: Sequence[plots.PlotKind], by_stage: bool
+    table: Any, metric: str, kinds: Sequence[plots.PlotKind], by_stage: bool,
+    fig_dir: Path | None, prefix: str,
 ) -> list[str]:
-    """The ``<img>`` tags of one metric's plots (a top-level function: it runs in workers)."""
-    return [_img(plots.plot_metric(table, metric, k, by_stage=by_stage), f"{metric} {k}")
-            for k in kinds]
+    """The ``<img>`` tag of one metric's figure, one panel per kind (runs in workers)."""
+    # headline figures carry the tables' column names ("Time facing", not the metric's name)
+    title = dict(HEADLINE_METRICS)[metric].split(" [")[0] if prefix == "headline" else None
+    fig = plots.plot_metric(table, metric, kinds, by_stage=by_stage, title=title)
+    return [_figure_tag(fig, f"{metric} {', '.join(kinds)}",
+                        figure_stem(fig_dir, f"{prefix}_{metric}"))]
 
 
 def _all_metric_images(
     table: Any, metrics: Sequence[str], kinds: Sequence[plots.PlotKind], by_stage: bool,
-    workers: int,
+    workers: int, fig_dir: Path | None, prefix: str,
 ) -> list[list[str]]:
     """:func:`_metric_images` for every metric, in ``workers`` processes (1: in this one)."""
     if workers <= 1 or len(metrics) < 2:
-        return [_metric_images(table, m, kinds, by_stage) for m in metrics]
+        return [_metric_images(table, m, kinds, by_stage, fig_dir, prefix) for m in metrics]
     import multiprocessing as mp
     from concurrent.futures import ProcessPoolExecutor
 
     with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn")) as pool:
-        futures = [pool.submit(_metric_images, table, m, list(kinds), by_stage)
+        futures = [pool.submit(_metric_images, table, m, list(kinds), by_stage, fig_dir, prefix)
                    for m in metrics]
         return [f.result() for f in futures]
 
 
-def _summary_html(rows: Sequence[SummaryRow]) -> str:
-    """One table per stage: a row per metric, a column per contestant (mean ± CI)."""
+def _cell_html(r: SummaryRow | None, digits: int, n_rows: int) -> str:
+    """``mean [lower, upper]``; low-n cells flagged ``n=k`` without interval."""
+    if r is None or r.n == 0:
+        return "<td>–</td>"
+    text = fmt(r.mean, digits)
+    if r.has_interval:
+        text += f' <span class="iv">[{fmt(r.lower, digits)}, {fmt(r.upper, digits)}]</span>'
+    elif r.low_n:
+        text += f' <span class="lown" title="fewer than {MIN_N} values">n={r.n}†</span>'
+    if r.n != n_rows and not r.low_n:
+        text += f' <span class="iv">n={r.n}</span>'
+    return f"<td>{text}</td>"
+
+
+def summary_html(rows: Sequence[SummaryRow], metrics: Sequence[str],
+                 episodes: Mapping[tuple[str, str], int],
+                 headers: Sequence[str] | None = None) -> str:
+    """One table per stage: a row per contestant, a column per metric, ``mean [lower, upper]``.
+
+    ``rows`` come from :func:`~arena.eval.tables.summary_table` (with ``overall=True`` the
+    :data:`~arena.eval.tables.ALL_STAGES` table comes first); each column keeps one number of
+    decimals; ``n`` is the contestant's episodes on the stage
+    (:func:`~arena.eval.tables.episode_counts`), a cell with fewer values shows its own n.
+    """
     stages = list(dict.fromkeys(r.stage for r in rows))
+    if ALL_STAGES in stages:
+        stages.remove(ALL_STAGES)
+        stages.insert(0, ALL_STAGES)
+    heads = list(headers) if headers is not None else [plots.metric_label(m) for m in metrics]
+    digits = {m: decimals([v for r in rows if r.metric == m for v in (r.mean, r.upper)])
+              for m in metrics}
     out = []
     for stage in stages:
         sub = [r for r in rows if r.stage == stage]
-        contestants = list(dict.fromkeys(r.contestant for r in sub))
-        metrics = list(dict.fromkeys(r.metric for r in sub))
         cell = {(r.contestant, r.metric): r for r in sub}
-        head = "".join(f"<th>{html.escape(c)}</th>" for c in contestants)
+        contestants = list(dict.fromkeys(r.contestant for r in sub))
         body = []
-        for m in metrics:
-            tds = []
-            for c in contestants:
-                r = cell.get((c, m))
-                if r is None:
-                    tds.append("<td>–</td>")
-                else:
-                    ci = f" ± {_fmt(r.ci)}" if math.isfinite(r.ci) else ""
-                    tds.append(f"<td>{_fmt(r.mean)}{ci}</td>")
-            body.append(f"<tr><td>{html.escape(plots.metric_label(m))}</td>{''.join(tds)}</tr>")
-        n = max((r.n for r in sub), default=0)
-        caption = f"<h3>{html.escape(stage)} <small>(n ≤ {n})</small></h3>" if stage else ""
-        out.append(f'{caption}<div class="scroll"><table><tr><th>metric</th>{head}</tr>'
+        for c in contestants:
+            n_rows = episodes.get((c, stage), 0)
+            tds = "".join(_cell_html(cell.get((c, m)), digits[m], n_rows) for m in metrics)
+            body.append(f"<tr><td>{html.escape(c)}</td><td>{n_rows}</td>{tds}</tr>")
+        title = "all stages" if stage == ALL_STAGES else stage
+        th = "".join(f"<th>{html.escape(h)}</th>" for h in heads)
+        out.append(f"<h3>{html.escape(title)}</h3>" if title else "")
+        out.append(f'<div class="scroll"><table><tr><th>planner</th><th>n</th>{th}</tr>'
                    f"{''.join(body)}</table></div>")
     return "".join(out)
 
@@ -252,148 +183,8 @@ def _poster(video: Path) -> str:
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
-def episode_grid(record: EpisodeRecord) -> Any:
-    """The map an episode ran on, obstacles burnt in, rebuilt from its recorded config.
-
-    Episodes are pure functions of (config, seed, index), so redrawing episode
-    ``record.meta.episode`` from ``record.meta.config`` gives the same map and obstacles,
-    generated or not. ``None`` if the record has no config or it no longer loads.
-    """
-    from arena.config.schema import ExperimentConfig
-    from arena.core.errors import ArenaError
-    from arena.experiment import planning_grid
-    from arena.tasks.generator import TaskGenerator
-
-    if not record.meta.config:
-        return None
-    try:
-        cfg = ExperimentConfig.model_validate(record.meta.config)
-        return planning_grid(TaskGenerator.from_config(cfg).episode(record.meta.episode))
-    except (ArenaError, ValueError):
-        return None
-
-
-def _episode_grids(
-    grids: Any, episodes: Mapping[int, Sequence[tuple[str, EpisodeRecord]]]
-) -> dict[int, Any]:
-    """Each episode's background grid.
-
-    From ``grids`` (one grid, or ``map_name -> grid``) or, with ``grids=None``, rebuilt from
-    the episode's recorded config (:func:`episode_grid`; the map does not depend on the
-    contestant, so the first record of the episode is used).
-    """
-    out: dict[int, Any] = {}
-    for e, paths in episodes.items():
-        rec = paths[0][1]
-        if isinstance(grids, Mapping):
-            out[e] = grids.get(rec.meta.map_name)
-        elif grids is not None:
-            out[e] = grids
-        else:
-            out[e] = episode_grid(rec)
-    return out
-
-
-def stage_trajectories(
-    cols: Mapping[str, np.ndarray],
-    run_dir: Path,
-    stage: str | None,
-    *,
-    grids: Any = None,
-    max_episodes: int = 9,
-) -> tuple[list[plots.TrajectoryPanel], str]:
-    """The trajectory panels of one stage (see :func:`arena.eval.plots.trajectory_panels`).
-
-    Loads the records of the stage's first ``max_episodes`` episodes (every contestant; the
-    episode index is the table's ``episode`` column, else the record's), groups them by
-    episode and finds each episode's map: one panel if all episodes share a map, else one
-    panel per episode. ``stage=None`` = every row.
-    """
-    from arena.eval.io import load_record
-
-    if "record" not in cols:
-        return [], ""
-    n = len(cols["contestant"])
-    mask = np.ones(n, bool) if stage is None or "stage" not in cols else cols["stage"] == stage
-    idx = np.flatnonzero(mask)
-    ep_col = cols.get("episode")
-    keys = [int(ep_col[i]) if ep_col is not None else -1 for i in idx]
-    wanted = set(sorted(k for k in set(keys))[:max(1, max_episodes)]) if ep_col is not None \
-        else None
-    episodes: dict[int, list[tuple[str, EpisodeRecord]]] = {}
-    total: set[int] = set(keys)
-    for i, key in zip(idx, keys, strict=True):
-        if wanted is not None and key not in wanted:
-            continue
-        rel = cols["record"][i]
-        p = run_dir / str(rel)
-        if not rel or not p.is_file():
-            continue
-        try:
-            rec = load_record(p)
-        except Exception:
-            continue
-        e = key if ep_col is not None else int(rec.meta.episode)
-        if ep_col is None:
-            total.add(e)
-            if e not in episodes and len(episodes) >= max_episodes:
-                continue
-        episodes.setdefault(e, []).append((str(cols["contestant"][i]), rec))
-    total.discard(-1)
-    return plots.trajectory_panels(episodes, _episode_grids(grids, episodes),
-                                   max_panels=max_episodes, total=len(total))
-
-
-def write_report(
-    table: Any,
-    run_dir: str | Path,
-    out_html: str | Path,
-    *,
-    grids: Any = None,
-    videos: Sequence[str | Path | tuple[str | Path, str]] = (),
-    title: str = "Arena benchmark report",
-    kinds: Sequence[plots.PlotKind] = plots.PLOT_KINDS,
-    metrics: Sequence[str] | None = None,
-    trajectory_episodes: int = 9,
-    workers: int = 1,
-) -> Path:
-    """Write one self-contained HTML report (no external assets).
-
-    Contents: title, run info (run folder, manifest fields if ``run.json`` exists, episodes,
-    contestants, stages, outcome counts), the summary table (mean ± 95 % CI), one figure per
-    metric and plot kind split by stage, the social radar chart, one trajectory figure per stage
-    (small multiples, every contestant in its colour; records loaded from
-    ``run_dir / table["record"]``, see :func:`stage_trajectories`), and the ``videos`` (MP4
-    files) embedded as base64, each with its first frame as poster.
-
-    Args:
-        table: the results table.
-        run_dir: the run folder (records are resolved relative to it).
-        out_html: the HTML file to write.
-        grids: an :class:`~arena.maps.grid.OccupancyGrid` for every trajectory plot, or a mapping
-            ``map_name -> grid``; ``None`` = rebuild each episode's map from its recorded config
-            (:func:`episode_grid`; blank background if that fails).
-        videos: MP4 files to embed, each a path or a ``(path, caption)`` pair (default
-            caption: the file's folder and name).
-        title: page title.
-        kinds: plot kinds to draw per metric.
-        metrics: metrics to plot and tabulate; ``None`` = all float non-key columns.
-        trajectory_episodes: most episodes per stage in the trajectory figure (one panel per
-            episode where each episode has its own map, else one shared panel).
-        workers: processes drawing the metric figures.
-
-    Returns:
-        The HTML path.
-    """
-    run_dir = Path(run_dir)
-    out_html = Path(out_html)
-    cols = plots.as_columns(table)
-    names = list(metrics) if metrics is not None else plots.metric_columns(cols)
-    contestants = plots.unique_in_order(cols["contestant"])
-    stages = plots.unique_in_order(cols["stage"]) if "stage" in cols else [""]
-    n_rows = len(cols["contestant"])
-    parts = [f"<h1>{html.escape(title)}</h1>"]
-
+def _run_info(run_dir: Path, cols: dict[str, np.ndarray], contestants: Sequence[str],
+              stages: Sequence[str]) -> str:
     info: list[tuple[str, str]] = [("run folder", str(run_dir)),
                                    ("generated", datetime.now(UTC).isoformat(
                                        timespec="seconds"))]
@@ -409,47 +200,132 @@ def write_report(
                          or len(json.dumps(v)) <= 300]
         except (OSError, ValueError):
             pass
-    info += [("episodes", str(n_rows)), ("contestants", ", ".join(contestants)),
+    info += [("episodes", str(len(cols["contestant"]))), ("contestants", ", ".join(contestants)),
              ("stages", ", ".join(stages))]
     if "outcome" in cols:
         outcomes, counts = np.unique(cols["outcome"].astype(str), return_counts=True)
         info.append(("outcomes", ", ".join(f"{o}: {n}" for o, n in
                                            zip(outcomes, counts, strict=True))))
-    parts.append("<h2>Run</h2><table>" + "".join(
-        f'<tr><td class="l">{html.escape(k)}</td><td class="l">{html.escape(v)}</td></tr>'
-        for k, v in info) + "</table>")
+    return "<h2>Run</h2><table>" + "".join(
+        f'<tr><td class="l">{html.escape(k)}</td><td class="l info">{html.escape(v)}</td></tr>'
+        for k, v in info) + "</table>"
 
-    parts.append("<h2>Summary (mean ± 95 % CI)</h2>")
-    parts.append(_summary_html(summary_table(table, names)))
 
+def _note(params: Any) -> str:
+    from arena.eval.metrics import MetricParams
+
+    p = params if params is not None else MetricParams()
+    rule = ("goal reached and fewer than 2 collisions (Arena 3.0 paper)"
+            if p.success_rule == "arena" else "goal reached, collisions allowed")
+    return (f"<p>Mean over episodes with its 95 % percentile-bootstrap interval [lower, upper] "
+            f"({RESAMPLES} resamples, fixed seed); n: episodes. Cells over fewer than {MIN_N} "
+            f"values show <span class=\"lown\">n=k†</span> and no interval (hatched bars in "
+            f"the figures). Success: {rule}. Private zone: a person's body closer than "
+            f"{p.private_zone_radius:g} m to the robot's body; personal-space radius "
+            f"{p.personal_space_radius:g} m (Hall). Time to goal: successful episodes only. "
+            "Time seen / facing: a person faced the robot / the robot faced a person.</p>")
+
+
+def write_report(
+    table: Any,
+    run_dir: str | Path,
+    out_html: str | Path,
+    *,
+    grids: Any = None,
+    videos: Sequence[str | Path | tuple[str | Path, str]] = (),
+    title: str = "Arena benchmark report",
+    kinds: Sequence[plots.PlotKind] = ("bar", "box"),
+    metrics: Sequence[str] | None = None,
+    trajectory_episodes: int = 9,
+    episode_figures: int = 200,
+    workers: int = 1,
+    figures: bool = True,
+    params: Any = None,
+) -> Path:
+    """Write one self-contained HTML report (no external assets) and its figure files.
+
+    Sections: run info; **results**: the headline tables (overall and per stage) and one
+    grouped-bar figure per headline metric (mean, bootstrap interval, n; planners on the x
+    axis, one colour per stage); **all metrics**: a collapsible table and, per other metric, a
+    collapsible block with one figure, a panel per plot kind in ``kinds``; the social radar
+    chart (fixed ranges); one trajectory figure per stage (see :func:`stage_trajectories`);
+    the **episodes** table, each row linking to its episode's trajectory thumbnail (at most
+    ``episode_figures``); the ``videos`` (MP4) embedded as base64, each with its last frame as
+    poster.
+
+    Args:
+        table: the results table.
+        run_dir: the run folder (records are resolved relative to it).
+        out_html: the HTML file to write.
+        grids: an :class:`~arena.maps.grid.OccupancyGrid` for every trajectory plot, or a mapping
+            ``map_name -> grid``; ``None`` = rebuild each episode's map from its recorded config
+            (blank background if that fails).
+        videos: MP4 files to embed, each a path or a ``(path, caption)`` pair (default
+            caption: the file's folder and name).
+        title: page title.
+        kinds: plot kinds drawn per non-headline metric.
+        metrics: metrics to plot and tabulate; ``None`` = all numeric non-key columns.
+        trajectory_episodes: most episodes per stage in the stage trajectory figure.
+        episode_figures: most per-episode trajectory thumbnails ((stage, episode) pairs).
+        workers: processes drawing the metric figures.
+        figures: also save every figure as PDF and SVG under ``figures/`` beside the page.
+        params: the metric parameters named in the notes (``None`` = defaults).
+
+    Returns:
+        The HTML path.
+    """
+    run_dir = Path(run_dir)
+    out_html = Path(out_html)
+    fig_dir = out_html.parent / "figures" if figures else None
+    cols = plots.as_columns(table)
+    names = list(metrics) if metrics is not None else plots.metric_columns(cols)
+    contestants = plots.unique_in_order(cols["contestant"])
+    stages = plots.unique_in_order(cols["stage"]) if "stage" in cols else [""]
     by_stage = len(stages) > 1
+    parts = [f"<h1>{html.escape(title)}</h1>", _run_info(run_dir, cols, contestants, stages)]
+
     plotted = [m for m in names if np.isfinite(np.asarray(cols[m], np.float64)).any()]
-    opened = {m for m in OPEN_METRICS if m in plotted} or set(plotted[:4])
+    counts = episode_counts(cols)
+    head = [(m, h) for m, h in HEADLINE_METRICS if m in plotted]
+    parts.append("<h2>Results</h2>" + _note(params))
+    if head:
+        rows = summary_table(cols, [m for m, _ in head], overall=by_stage)
+        parts.append(summary_html(rows, [m for m, _ in head], counts, [h for _, h in head]))
+        images = _all_metric_images(table, [m for m, _ in head], ("bar",), by_stage, workers,
+                                    fig_dir, "headline")
+        parts.append('<div class="figs">' + "".join(t for tags in images for t in tags)
+                     + "</div>")
+
+    others = [m for m in plotted if m not in dict(head)]
     if plotted:
-        parts.append("<h2>Metrics</h2><p>Per metric: mean with 95 % CI (bar), box, violin and "
-                     "strip plots by contestant and stage; click a metric to expand it.</p>")
-    images = _all_metric_images(table, plotted, kinds, by_stage, workers)
-    for m, figs in zip(plotted, images, strict=True):
-        parts.append(f"<details{' open' if m in opened else ''}><summary>"
-                     f"{html.escape(plots.metric_label(m))}</summary>"
+        rows = summary_table(cols, plotted, overall=by_stage)
+        parts.append("<h2>All metrics</h2><details><summary>Table of every metric (mean "
+                     "[interval])</summary>" + summary_html(rows, plotted, counts) + "</details>")
+    images = _all_metric_images(table, others, kinds, by_stage, workers, fig_dir, "metric")
+    for m, figs in zip(others, images, strict=True):
+        parts.append(f"<details><summary>{html.escape(plots.metric_label(m))}</summary>"
                      f'<div class="figs">{"".join(figs)}</div></details>')
 
     social = [m for m in plots.SOCIAL_METRICS if m in cols and m in names]
     if social and len(contestants) > 1:
-        parts.append('<h2>Social metrics</h2><div class="wide">'
-                     + _img(plots.plot_radar(table, social), "radar") + "</div>")
+        parts.append('<h2>Social metrics</h2><div class="wide">' + _figure_tag(
+            plots.plot_radar(table, social), "radar", figure_stem(fig_dir, "radar")) + "</div>")
 
     traj = []
     for s in stages:
         panels, note = stage_trajectories(cols, run_dir, s if "stage" in cols else None,
                                           grids=grids, max_episodes=trajectory_episodes)
         if panels:
-            fig = plots.plot_stage_trajectories(
+            fig = plot_stage_trajectories(
                 panels, contestants, title=f"Trajectories: {s}" if s else "Trajectories",
                 note=note)
-            traj.append(_img(fig, f"trajectories {s}"))
+            traj.append(_figure_tag(fig, f"trajectories {s}",
+                                    figure_stem(fig_dir, f"trajectories_{s or 'all'}")))
     if traj:
         parts.append(f'<h2>Trajectories</h2><div class="traj">{"".join(traj)}</div>')
+
+    thumbs = episode_thumbnails(cols, run_dir, grids=grids, max_figures=episode_figures)
+    parts.append("<h2>Episodes</h2>" + episode_section(cols, thumbs))
 
     vids = []
     for v in videos:
@@ -466,7 +342,7 @@ def write_report(
 
     doc = (f'<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
-           + "\n".join(parts) + "</body></html>\n")
+           + "\n".join(parts) + OPEN_TARGET_JS + "</body></html>\n")
     out_html.parent.mkdir(parents=True, exist_ok=True)
     out_html.write_text(doc, encoding="utf-8")
     return out_html
@@ -494,7 +370,7 @@ def main(
         workers: processes drawing the figures and rendering the videos.
 
     Returns:
-        ``{"html": ..., "csv": ..., "tex": ...}`` paths.
+        ``{"html": ..., "csv": ..., "tex": ..., "figures": ...}`` paths.
     """
     from arena.eval.store import load_results
 
@@ -513,7 +389,7 @@ def main(
     clips.extend(videos)
     html_path = write_report(table, run, dest / "report.html", grids=grids, videos=clips,
                              workers=workers)
-    return {"html": html_path, "csv": csv_path, "tex": tex_path}
+    return {"html": html_path, "csv": csv_path, "tex": tex_path, "figures": dest / "figures"}
 
 
-__all__ = ["SummaryRow", "latex_table", "main", "summary_table", "write_report", "write_tables"]
+__all__ = ["figure_stem", "main", "summary_html", "write_report"]

@@ -38,6 +38,7 @@ def build_columns(records: list[str] | None = None) -> dict[str, np.ndarray]:
                     metrics.setdefault(k, []).append(float(v[i]))
     cols = {k: np.asarray(v) for k, v in rows.items()}
     cols.update({k: np.asarray(v, float) for k, v in metrics.items()})
+    cols["collisions"] = cols["collisions"].astype(np.int64)  # an integer count, as in runs
     n = len(cols["episode"])
     cols["record"] = np.asarray(records if records is not None else [""] * n)
     return cols

@@ -1,57 +1,13 @@
-import math
 import re
+import xml.etree.ElementTree as ET
 
 import numpy as np
-import pytest
-from scipy import stats
 
 from arena.eval import report
 from arena.eval.io import save_record
 from arena.maps.grid import OccupancyGrid
 from tests.eval._records import make_record
-from tests.eval._table import CONTESTANTS, STAGES, build_table, values
-
-
-def _hand_ci(v):
-    v = np.asarray(v, float)
-    n = v.size
-    mean = sum(v) / n
-    s = math.sqrt(sum((x - mean) ** 2 for x in v) / (n - 1))
-    return mean, stats.t.ppf(0.975, n - 1) * s / math.sqrt(n)
-
-
-def test_summary_means_and_ci_by_hand():
-    rows = report.summary_table(build_table())
-    assert len(rows) == 2 * 2 * 7
-    by = {(r.contestant, r.stage, r.metric): r for r in rows}
-    for c, cn in enumerate(CONTESTANTS):
-        for s, sn in enumerate(STAGES):
-            for m, v in values(c, s).items():
-                r = by[(cn, sn, m)]
-                mean, ci = _hand_ci(v)
-                assert r.n == 5
-                assert r.mean == pytest.approx(mean)
-                assert r.ci == pytest.approx(ci)
-                assert r.lower == pytest.approx(mean - ci)
-    # time_to_goal alpha/easy: 10..14 -> mean 12, s = sqrt(2.5), t(0.975, 4) = 2.7764451
-    r = by[("alpha", "easy", "time_to_goal")]
-    assert r.mean == pytest.approx(12.0)
-    assert r.ci == pytest.approx(2.7764451 * math.sqrt(2.5) / math.sqrt(5), rel=1e-6)
-    assert r.unit == "s"
-
-
-def test_write_tables_csv_and_latex(tmp_path):
-    csv_path, tex_path = report.write_tables(build_table(), tmp_path / "out")
-    lines = csv_path.read_text().splitlines()
-    assert lines[0].startswith("contestant,stage,metric,unit,n,mean,ci95")
-    assert len(lines) == 1 + 28
-    tex = tex_path.read_text()
-    assert r"\toprule" in tex and r"\midrule" in tex and r"\bottomrule" in tex
-    ci = 2.7764451 * math.sqrt(2.5) / math.sqrt(5)
-    assert rf"time\_to\_goal [s] & alpha & easy & 5 & 12.000 $\pm$ {ci:.3f} \\" in tex
-    # beta/hard time_to_goal: 15..19 -> mean 17
-    assert rf"time\_to\_goal [s] & beta & hard & 5 & 17.000 $\pm$ {ci:.3f} \\" in tex
-    assert tex.count(r"\\") == 28 + 1
+from tests.eval._table import CONTESTANTS, STAGES, build_table
 
 
 def _write_records(run):
@@ -83,12 +39,45 @@ def test_write_report_self_contained(tmp_path):
     srcs = re.findall(r'src="([^"]*)"', text)
     assert srcs and all(s.startswith("data:") for s in srcs)
     n_png = sum(s.startswith("data:image/png;base64,") for s in srcs)
-    # 7 metrics x 2 kinds + radar + one trajectory figure per stage
-    assert n_png == 7 * 2 + 1 + 2
+    # 7 metrics: 5 headline (a bar figure each), 2 others (one figure each: bar and box
+    # panels), radar, one trajectory figure per stage, one thumbnail per (stage, episode)
+    assert n_png == 5 + 2 + 1 + 2 + 2 * 5
     assert any(s.startswith("data:video/mp4;base64,") for s in srcs)
     for c in CONTESTANTS:
         assert c in text
-    assert "Time to goal [s]" in text and "12.000 ± " in text
+    # the headline table leads: collisions (an integer column) with its interval and n
+    results = text[text.index("<h2>Results</h2>"):text.index("<h2>All metrics</h2>")]
+    assert "<th>Collisions</th>" in results and "<th>Time to goal [s]</th>" in results
+    assert "<h3>all stages</h3>" in results and "<h3>easy</h3>" in results
+    assert "<td>alpha</td><td>5</td>" in results  # n per planner and stage
+    assert "personal-space radius 1.2 m" in results
+    assert re.search(r"<td>12\.0 <span class=\"iv\">\[1\d\.\d, 1\d\.\d\]</span></td>",
+                     results)
+    # every figure also as PDF and SVG, stable names
+    figs = out.parent / "figures"
+    for stem in ("headline_success", "headline_collisions", "metric_min_distance_to_person",
+                 "radar", "trajectories_easy"):
+        assert (figs / f"{stem}.pdf").read_bytes().startswith(b"%PDF")
+        assert ET.parse(figs / f"{stem}.svg").getroot().tag.endswith("svg")
+    assert len(list(figs.glob("*.pdf"))) == len(list(figs.glob("*.svg"))) == 5 + 2 + 1 + 2
+    # the episode table: one row per episode and contestant, each linking to its trajectory
+    links = re.findall(r'<a href="#(ep-[^"]+)">trajectory</a>', text)
+    assert len(links) == 20 and set(links) == {f"ep-{s}-{i}" for s in ("easy", "hard")
+                                               for i in range(5)}
+    for a in set(links):
+        assert f'<figure id="{a}">' in text
+    assert "openTarget" in text  # following a link opens the collapsed section
+
+
+def test_episode_thumbnails_are_capped(tmp_path):
+    run = tmp_path / "run"
+    recs = _write_records(run)
+    out = report.write_report(build_table(recs), run, tmp_path / "report.html",
+                              kinds=("bar",), episode_figures=3, figures=False)
+    text = out.read_text()
+    assert len(re.findall(r"<figure id=", text)) == 3
+    assert "for the first 3 of 10 (stage, episode) pairs" in text
+    assert not (tmp_path / "figures").exists()
 
 
 def test_main_reads_store(tmp_path, monkeypatch):
@@ -100,12 +89,13 @@ def test_main_reads_store(tmp_path, monkeypatch):
     paths = report.main(run)
     assert paths["html"] == run / "report" / "report.html"
     assert paths["html"].is_file() and paths["csv"].is_file() and paths["tex"].is_file()
+    assert (paths["figures"] / "headline_success.pdf").is_file()
 
 
 def test_trajectory_maps_are_rebuilt_from_the_records(tmp_path):
     from arena.config.loader import load_config
     from arena.eval.io import load_record
-    from arena.eval.report import episode_grid, stage_trajectories
+    from arena.eval.report_trajectories import episode_grid, stage_trajectories
     from arena.experiment import planning_grid, run_experiment
     from arena.tasks.generator import TaskGenerator
 
@@ -135,3 +125,17 @@ def test_trajectory_maps_are_rebuilt_from_the_records(tmp_path):
     assert panels[0].grid != panels[1].grid and "per episode" in note
     panels, note = stage_trajectories(cols, tmp_path, "s", max_episodes=1)
     assert len(panels) == 1 and note == "episodes 0 of 2 shown, one map"
+
+
+def test_summary_html_n_is_episodes_and_cells_with_fewer_values_say_so():
+    from arena.eval.tables import episode_counts, summary_table
+
+    cols = {"contestant": np.array(["a"] * 6), "stage": np.array(["s"] * 6),
+            "time_to_goal": np.array([5.0, 6.0, np.nan, 7.0, 5.5, 6.5]),  # 1 failure
+            "success": np.array([1.0, 1.0, 0.0, 1.0, 1.0, 1.0])}
+    counts = episode_counts(cols)
+    assert counts == {("a", "s"): 6, ("a", "(all)"): 6}
+    text = report.summary_html(summary_table(cols), ["time_to_goal", "success"], counts)
+    assert "<td>a</td><td>6</td>" in text
+    assert re.search(r'<td>6\.00 <span class="iv">\[[\d.]+, [\d.]+\]</span> '
+                     r'<span class="iv">n=5</span></td>', text)

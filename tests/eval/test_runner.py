@@ -281,7 +281,7 @@ def test_cli_report(reference: pa.Table, files: tuple[Path, Path], tmp_path: Pat
     assert "pure_pursuit" in html and "data:image/png;base64," in html
     # one re-simulated episode per contestant, by default
     assert html.count("data:video/mp4;base64,") == 2 and "episode " in html
-    assert (run / "report" / "summary.tex").read_text().count("\\toprule") == 1
+    assert (run / "report" / "summary.tex").read_text().count("\\toprule") == 2  # all, stages
     monkeypatch.setattr(sys, "argv", ["arena", "report", str(tmp_path)])
     with pytest.raises(SystemExit) as e:
         cli.main()
