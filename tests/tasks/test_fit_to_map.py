@@ -1,4 +1,4 @@
-"""The demo's goal distance on a user's small map: lowered to fit, and said; explicit ones hold."""
+"""The demo on a user's small map: goal distance and obstacle counts fit it, and say so."""
 
 from __future__ import annotations
 
@@ -110,3 +110,34 @@ def test_every_start_in_the_largest_region_has_a_goal_at_the_fitting_distance():
     xy = grid.cell_to_world(cells)
     farthest = np.sqrt(np.max(np.sum((xy[:, None] - xy[None]) ** 2, axis=-1), axis=1))
     assert np.all(farthest >= fit + grid.resolution - 1e-9)
+
+
+FEWER = re.compile(r"task\.obstacles\.(static|dynamic): not all (4|12) (obstacles|pedestrians) fit")
+
+
+def test_demo_obstacle_counts_fit_a_small_room_and_say_so():
+    tiny = ["map.type=empty", "map.width=4", "map.height=4"]
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")  # (the goal distance's warning is recorded too)
+        episodes = _episodes(tiny, n=4)
+    said = sorted(FEWER.search(str(w.message)).group(1) for w in record
+                  if FEWER.search(str(w.message)))
+    assert said == ["dynamic", "static"], "one warning per kind, map and run"
+    for ep in episodes:
+        assert len(ep.obstacles) < 4 and 0 < len(ep.agents.positions) < 12
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        again = _episodes(tiny, n=4)
+    assert [len(e.obstacles) for e in again] == [len(e.obstacles) for e in episodes]
+    assert all(np.array_equal(a.agents.positions, b.agents.positions)
+               for a, b in zip(again, episodes, strict=True))
+
+
+def test_obstacle_counts_that_must_hold_are_an_error():
+    tiny = ["map.type=empty", "map.width=4", "map.height=4", "task.obstacles.when_full=error"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # the goal distance's
+        with pytest.raises(SamplingError, match=r"task\.obstacles\.static: .*obstacles"):
+            _episodes(tiny, n=1)
+        with pytest.raises(SamplingError, match=r"cannot place 12 pedestrians"):
+            _episodes([*tiny, "task.obstacles.static=0"], n=1)
