@@ -434,6 +434,7 @@ class NavigationStack:
         self.replans = 0
         self._path = np.zeros((0, 2))
         self._nearest_free: dict[int, NDArray[np.int64]] = {}
+        self._wide_labels: NDArray[np.int32] | None = None
         self._time = 0.0
         self._last_plan_time = 0.0
         self._retry_after = -math.inf
@@ -623,6 +624,7 @@ class NavigationStack:
                 else fine.inflate(self.footprint_radius + self.inflation_margin)
             )
             self._nearest_free = {}
+            self._wide_labels = None
             self.global_costmap = None
         inscribed = self.robot_radius + self.inflation_margin
         gcfg, lcfg = self.global_costmap_config, self.local_costmap_config
@@ -1046,16 +1048,38 @@ class NavigationStack:
 
     def _plan_from(self, start: Pose2D, *, mark_scan: bool = False) -> NDArray[np.float64]:
         """Plan with the robot radius; where that fails, with the footprint's (narrow passages)."""
-        try:
-            path = self._plan_with(start, mark_scan, footprint=False)
-        except PlanningError:
-            if self.inflated_footprint is None or self.global_costmap is not None:
-                raise
-            path = self._plan_with(start, mark_scan, footprint=True)
-            self.footprint_plan = True
-            return path
-        self.footprint_plan = False
+        narrow = self.inflated_footprint is not None and self.global_costmap is None
+        if not (narrow and self._apart_for_the_circle(start)):
+            try:
+                path = self._plan_with(start, mark_scan, footprint=False)
+            except PlanningError:
+                if not narrow:
+                    raise
+            else:
+                self.footprint_plan = False
+                return path
+        path = self._plan_with(start, mark_scan, footprint=True)
+        self.footprint_plan = True
         return path
+
+    def _apart_for_the_circle(self, start: Pose2D) -> bool:
+        """Whether start and goal lie in different free regions of :attr:`inflated`.
+
+        Then planning with the robot radius surely fails (a scan marked on the grid only blocks
+        more), so a replan in a narrow passage need not search the whole region first. The
+        8-connected regions are labelled once per map; a start in the inflated zone is not
+        judged (its way out is found by the planning).
+        """
+        assert self.inflated is not None
+        if self._wide_labels is None:
+            self._wide_labels = ndimage.label(
+                ~self.inflated.occupied, structure=np.ones((3, 3), dtype=bool)
+            )[0]
+        cells = self.inflated.world_to_cell(np.array([start.xy, self.goal.xy]))
+        if not bool(np.all(self.inflated.in_bounds(cells))):
+            return False
+        a, b = self._wide_labels[cells[:, 0], cells[:, 1]]
+        return bool(a > 0 and b > 0 and a != b)
 
     def _plan_with(
         self, start: Pose2D, mark_scan: bool, *, footprint: bool

@@ -70,6 +70,18 @@ def test_plan_goes_through_a_door_the_footprint_fits():
     assert _edge_clearance(grid, path) >= JACKAL.inscribed_radius
 
 
+def test_a_replan_in_a_narrow_passage_plans_once():
+    """Start and goal apart for the circle: no full search of the circle's region first."""
+    stack = _stack()
+    calls = []
+    plan = stack.global_planner.plan
+    stack.global_planner.plan = lambda grid, s, g: calls.append(grid) or plan(grid, s, g)
+    stack.reset(_door_map(0.6), Pose2D(2.0, 3.0, 0.0), Pose2D(8.0, 3.0, 0.0))
+    assert calls == [stack.inflated_footprint]
+    assert stack.replan(Pose2D(2.5, 3.0, 0.0))
+    assert calls[1:] == [stack.inflated_footprint]
+
+
 def test_no_plan_through_a_door_narrower_than_the_footprint():
     stack = _stack()
     with pytest.raises(PlanningError):
