@@ -287,6 +287,10 @@ _PATH_SAMPLE_STEP = 0.1
 """m, spacing of the path samples checked for blocking."""
 
 
+_MAX_PLANNING_CELLS = 16_000_000
+"""Most cells :func:`subdivide` makes (4000 × 4000; the search keeps ~10 arrays of that size)."""
+
+
 def subdivide(grid: OccupancyGrid, max_resolution: float) -> OccupancyGrid:
     """``grid`` with each cell split into ``k × k`` equal cells of at most ``max_resolution`` m.
 
@@ -294,9 +298,11 @@ def subdivide(grid: OccupancyGrid, max_resolution: float) -> OccupancyGrid:
     distance map measures centre to centre, so on a 0.5 m map an inflation below 0.5 m marks
     no cell and a plan through the cells next to a wall keeps only 0.25 m from it, less than a
     jackal's radius (the robot drove into the wall and stalled). On cells of ``max_resolution``
-    the inflation errs by at most half of it.
+    the inflation errs by at most half of it. The split stops short of
+    :data:`_MAX_PLANNING_CELLS` cells (a 1 km map of 0.5 m cells gets 0.25 m ones).
     """
     k = math.ceil(grid.resolution / max_resolution - 1e-9)
+    k = min(k, max(int(math.sqrt(_MAX_PLANNING_CELLS / grid.data.size)), 1))
     if k <= 1:
         return grid
     data = np.repeat(np.repeat(grid.data, k, axis=0), k, axis=1)

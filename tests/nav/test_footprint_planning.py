@@ -137,6 +137,8 @@ def test_subdivide_keeps_the_walls():
     assert np.array_equal(fine.is_occupied(pts), grid.is_occupied(pts))
     small = _door_map(0.6)
     assert subdivide(small, 0.1) is small
+    huge = OccupancyGrid.from_occupied(np.zeros((2000, 2000), dtype=bool), 0.5)  # 1 km
+    assert subdivide(huge, 0.1).resolution == pytest.approx(0.25)  # 16 million cells at most
 
 
 def test_coarse_map_plan_keeps_the_robot_off_the_walls():
