@@ -73,7 +73,10 @@ def test_a_map_that_held_the_distance_before_gets_the_same_draws():
 def test_an_explicit_min_goal_distance_that_cannot_fit_is_an_error():
     with warnings.catch_warnings():
         warnings.simplefilter("error", UserWarning)  # and no "lowered" warning
-        with pytest.raises(SamplingError, match=r"12 m apart.*task\.robots\.min_goal_distance"):
+        with pytest.raises(
+            SamplingError,
+            match=r"12 m apart.* largest free region is [0-9.]+ m across.*min_goal_distance",
+        ):
             _episodes([*ROOM, "task.robots.min_goal_distance=12"], n=1)
 
 

@@ -105,17 +105,20 @@ def sample_start_goal(
 
 
 def _extent(world: WorldSampler, clearance: float) -> str:
-    """``" (free positions here are at most D m apart)"``: the diagonal of their bounding box.
+    """How far apart free positions can be, for the error (e.g. 12 m asked in an 8 m room).
 
-    An upper bound on any start-goal distance the map allows, so that the error says how far
-    off the request is (e.g. the demo's 12 m in an 8 m room).
+    The largest region's diameter (:func:`free_extent`), and the diagonal of the bounding box
+    of all free positions: an upper bound on any start-goal distance the map allows.
     """
     rows, cols = np.nonzero(world.candidate_mask(clearance))
     if rows.size == 0:
         return " (no free position at that clearance)"
     res = world.grid.resolution
     span = float(np.hypot(np.ptp(rows) + 1, np.ptp(cols) + 1)) * res
-    return f" (free positions here are at most {span:.1f} m apart)"
+    return (
+        f" (the largest free region is {free_extent(world, clearance):.1f} m across; free "
+        f"positions here are at most {span:.1f} m apart)"
+    )
 
 
 def free_extent(world: WorldSampler, clearance: float) -> float:
