@@ -291,7 +291,10 @@ def run_episode(
     seed, idx = cfg.seed, episode.index
     crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
     state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
-    stack = NavigationStack.from_config(cfg.navigation, robot_radius=robot.radius)
+    stack = NavigationStack.from_config(
+        cfg.navigation, robot_radius=robot.radius,
+        footprint_radius=robot.inscribed_radius or None,  # narrow passages: the body fits
+    )
     stack.scan_range_max = float(robot.laser.range_max)
     stack.goal_tolerance_xy = min(stack.goal_tolerance_xy, 0.9 * episode.goal_radius)
     if episode.goal_tolerance_angle is not None:

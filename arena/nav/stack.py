@@ -16,6 +16,17 @@ Policies (documented here because tasks and metrics depend on them):
   segment from the robot to that cell crosses no occupied cell of the *uninflated* map. Only a
   robot whose position is blocked in the raw map (or walled off from free space) fails with
   :class:`~arena.core.errors.StartOccupied`.
+- **Narrow passages.** The map is inflated by the robot's bounding circle (``robot_radius +
+  inflation_margin``), which closes doors the robot fits through sideways-on: a jackal (0.267 m
+  circle, 0.33 m wide) and Arena's 0.6 m doors. Where that map has no route (or the start or
+  goal lies in its inflated zone), the stack plans on the map inflated by the footprint's
+  inscribed radius instead (``footprint_radius + inflation_margin``): like a ROS costmap's
+  lethal zone, cells where the footprint collides in every heading. :attr:`footprint_plan`
+  says which one the path came from. Routes the circle fits through are always preferred, even
+  when longer. (Not with a global costmap, which plans on its own inscribed radius.)
+- **Coarse maps** are planned on their cells split to at most ``planning_resolution`` (0.1 m):
+  distances are measured centre to centre, so on Arena's 0.4–0.5 m maps an inflation below one
+  cell marked nothing and plans passed 0.25 m from walls, closer than the robot's radius.
 - **Goal inside the inflated zone** fails with :class:`~arena.core.errors.GoalOccupied`: goals
   must be sampled with at least ``robot_radius + inflation_margin`` of clearance.
 - **Failures.** If the plan made by :meth:`~NavigationStack.reset` fails, :attr:`status` becomes
@@ -221,6 +232,10 @@ class NavigationConfig(BaseModel):
     inflation_margin: float = Field(
         0.05, ge=0, description="m of clearance added to the robot radius when inflating the map"
     )
+    planning_resolution: float = Field(
+        0.1, gt=0, description="m; a map with coarser cells is planned on its cells split to at "
+        "most this size, so the inflation is exact to within it"
+    )
     goal_tolerance_xy: float = Field(0.3, gt=0, description="m, distance that counts as arrived")
     goal_tolerance_yaw: float | None = Field(
         None, gt=0, description="rad, heading error that counts as arrived; None ignores heading"
@@ -272,6 +287,28 @@ _PATH_SAMPLE_STEP = 0.1
 """m, spacing of the path samples checked for blocking."""
 
 
+_MAX_PLANNING_CELLS = 16_000_000
+"""Most cells :func:`subdivide` makes (4000 × 4000; the search keeps ~10 arrays of that size)."""
+
+
+def subdivide(grid: OccupancyGrid, max_resolution: float) -> OccupancyGrid:
+    """``grid`` with each cell split into ``k × k`` equal cells of at most ``max_resolution`` m.
+
+    The same walls at a finer raster (``grid`` itself when its cells are small enough): a
+    distance map measures centre to centre, so on a 0.5 m map an inflation below 0.5 m marks
+    no cell and a plan through the cells next to a wall keeps only 0.25 m from it, less than a
+    jackal's radius (the robot drove into the wall and stalled). On cells of ``max_resolution``
+    the inflation errs by at most half of it. The split stops short of
+    :data:`_MAX_PLANNING_CELLS` cells (a 1 km map of 0.5 m cells gets 0.25 m ones).
+    """
+    k = math.ceil(grid.resolution / max_resolution - 1e-9)
+    k = min(k, max(int(math.sqrt(_MAX_PLANNING_CELLS / grid.data.size)), 1))
+    if k <= 1:
+        return grid
+    data = np.repeat(np.repeat(grid.data, k, axis=0), k, axis=1)
+    return OccupancyGrid(data, grid.resolution / k, grid.origin, grid.unknown_is_occupied)
+
+
 def _ped_array(peds: Pedestrians) -> NDArray[np.float64]:
     """``(n, 4)`` ``[x, y, vx, vy]`` rows (m, m/s, world frame) of ``peds``."""
     pos = np.asarray(peds.positions, dtype=np.float64).reshape(-1, 2)
@@ -289,6 +326,12 @@ class NavigationStack:
         local_planner: turns the path into commands.
         robot_radius: radius of the robot's bounding circle (m).
         inflation_margin: clearance added to ``robot_radius`` when inflating the map (m).
+        footprint_radius: inscribed radius of the robot's footprint (m): the largest disc about
+            the robot origin inside it. Where the map inflated by ``robot_radius`` closes every
+            route, the plan is made on the map inflated by ``footprint_radius +
+            inflation_margin`` (see "Narrow passages" in the module docstring). ``None`` (or
+            not below ``robot_radius``) plans with ``robot_radius`` only.
+        planning_resolution: largest cell size planned on (m); coarser maps are subdivided.
         replan_period: seconds between replans; 0 plans only at reset (and on deviation).
         goal_tolerance: ``(xy m, yaw rad or None)``; ``None`` ignores the heading.
         max_path_deviation: distance from the path (m) that triggers an immediate replan.
@@ -324,6 +367,8 @@ class NavigationStack:
         *,
         robot_radius: float,
         inflation_margin: float = _DEFAULTS.inflation_margin,
+        footprint_radius: float | None = None,
+        planning_resolution: float = _DEFAULTS.planning_resolution,
         replan_period: float = _DEFAULTS.replan_period,
         goal_tolerance: tuple[float, float | None] = (
             _DEFAULTS.goal_tolerance_xy,
@@ -348,6 +393,10 @@ class NavigationStack:
     ) -> None:
         if not robot_radius > 0:
             raise ConfigError(f"robot_radius must be > 0 m, got {robot_radius}")
+        if footprint_radius is not None and not footprint_radius > 0:
+            raise ConfigError(f"footprint_radius must be > 0 m, got {footprint_radius}")
+        if not planning_resolution > 0:
+            raise ConfigError(f"planning_resolution must be > 0 m, got {planning_resolution}")
         if inflation_margin < 0 or replan_period < 0 or not max_path_deviation > 0:
             raise ConfigError(
                 "inflation_margin and replan_period must be >= 0 and max_path_deviation > 0, got "
@@ -368,6 +417,11 @@ class NavigationStack:
         self.local_planner = local_planner
         self.robot_radius = float(robot_radius)
         self.inflation_margin = float(inflation_margin)
+        self.footprint_radius = (
+            None if footprint_radius is None or footprint_radius >= robot_radius
+            else float(footprint_radius)
+        )
+        self.planning_resolution = float(planning_resolution)
         self.replan_period = float(replan_period)
         self.goal_tolerance_xy = float(goal_tolerance[0])
         self.goal_tolerance_yaw = None if goal_tolerance[1] is None else float(goal_tolerance[1])
@@ -375,12 +429,18 @@ class NavigationStack:
         self.kinematics = kinematics
         self.grid: OccupancyGrid | None = None
         self.inflated: OccupancyGrid | None = None
+        """The planning grid inflated by ``robot_radius + inflation_margin``."""
+        self.inflated_footprint: OccupancyGrid | None = None
+        """The planning grid inflated by ``footprint_radius + inflation_margin`` (or ``None``)."""
+        self.footprint_plan = False
+        """Whether the current path was planned with the footprint radius (a narrow passage)."""
         self.goal = Pose2D()
         self.status = NavStatus.FAILED
         self.last_error: PlanningError | None = None
         self.replans = 0
         self._path = np.zeros((0, 2))
-        self._nearest_free: NDArray[np.int64] | None = None
+        self._nearest_free: dict[int, NDArray[np.int64]] = {}
+        self._wide_labels: NDArray[np.int32] | None = None
         self._time = 0.0
         self._last_plan_time = 0.0
         self._retry_after = -math.inf
@@ -443,6 +503,7 @@ class NavigationStack:
         robot_radius: float,
         source: str | None = None,
         *,
+        footprint_radius: float | None = None,
         kinematics: str | None = None,
         path: str | None = "navigation",
     ) -> NavigationStack:
@@ -452,6 +513,7 @@ class NavigationStack:
             cfg: the block (a model, a plain mapping, or ``None`` for all defaults).
             robot_radius: radius of the robot's bounding circle (m).
             source: file the block came from, for error messages.
+            footprint_radius: the footprint's inscribed radius (m), for narrow passages.
             kinematics: the robot's kinematics name (checked against the local planner).
             path: key path of the block inside ``source``, for error messages.
 
@@ -489,6 +551,8 @@ class NavigationStack:
         try:
             return cls(
                 gp, lp, robot_radius=robot_radius, inflation_margin=cfg.inflation_margin,
+                footprint_radius=footprint_radius,
+                planning_resolution=cfg.planning_resolution,
                 replan_period=cfg.replan_period,
                 goal_tolerance=(cfg.goal_tolerance_xy, cfg.goal_tolerance_yaw),
                 max_path_deviation=cfg.max_path_deviation, kinematics=kinematics,
@@ -559,15 +623,22 @@ class NavigationStack:
         """
         if grid is not self.grid or self.inflated is None:
             # Grids are immutable, so episodes on the same map share one inflation (an EDT).
-            self.inflated = grid.inflate(self.robot_radius + self.inflation_margin)
-            self._nearest_free = None
+            fine = subdivide(grid, self.planning_resolution)
+            self.inflated = fine.inflate(self.robot_radius + self.inflation_margin)
+            self.inflated_footprint = (
+                None if self.footprint_radius is None
+                else fine.inflate(self.footprint_radius + self.inflation_margin)
+            )
+            self._nearest_free = {}
+            self._wide_labels = None
             self.global_costmap = None
         inscribed = self.robot_radius + self.inflation_margin
         gcfg, lcfg = self.global_costmap_config, self.local_costmap_config
         if gcfg is not None:
             if self.global_costmap is None:
                 self.global_costmap = GlobalCostmap(
-                    grid, gcfg.params(inscribed, use_semantic=False)
+                    subdivide(grid, self.planning_resolution),
+                    gcfg.params(inscribed, use_semantic=False),
                 )
             else:  # same map: forget the previous episode's obstacles
                 self.global_costmap.obstacles.costs[:] = 0
@@ -946,12 +1017,15 @@ class NavigationStack:
         self._last_plan_time = self._time
         self._retry_after = -math.inf
 
-    def _planning_grid(self, mark_scan: bool) -> tuple[OccupancyGrid, Costmap | None]:
+    def _planning_grid(
+        self, mark_scan: bool, *, footprint: bool = False
+    ) -> tuple[OccupancyGrid, Costmap | None]:
         """The occupancy grid to plan on, and the global costmap's master when configured.
 
-        Without a global costmap: the inflated map, with the last scan's returns marked (inflated
-        alike) when ``mark_scan``. With one: its lethal/inscribed cells, after folding the last
-        scan into its obstacle layer when ``mark_scan`` (every tick already with ``use_scan``).
+        Without a global costmap: the inflated map (by the footprint radius when ``footprint``),
+        with the last scan's returns marked (inflated alike) when ``mark_scan``. With one: its
+        lethal/inscribed cells, after folding the last scan into its obstacle layer when
+        ``mark_scan`` (every tick already with ``use_scan``).
         """
         assert self.inflated is not None
         gcm, gcfg = self.global_costmap, self.global_costmap_config
@@ -960,10 +1034,12 @@ class NavigationStack:
                 self._fold_scan_into_global()
             master = gcm.update()
             return master.to_occupancy(INSCRIBED), master
+        grid, radius = self.inflated, self.robot_radius
+        if footprint and self.inflated_footprint is not None and self.footprint_radius:
+            grid, radius = self.inflated_footprint, self.footprint_radius
         if mark_scan and len(self._scan_world):
-            radius = self.robot_radius + self.inflation_margin
-            return mark_points(self.inflated, self._scan_world, radius), None
-        return self.inflated, None
+            return mark_points(grid, self._scan_world, radius + self.inflation_margin), None
+        return grid, None
 
     def _plan_on(
         self, grid: OccupancyGrid, costmap: Costmap | None, start: Pose2D
@@ -977,9 +1053,46 @@ class NavigationStack:
         return self.global_planner.plan(grid, start, self.goal)
 
     def _plan_from(self, start: Pose2D, *, mark_scan: bool = False) -> NDArray[np.float64]:
+        """Plan with the robot radius; where that fails, with the footprint's (narrow passages)."""
+        narrow = self.inflated_footprint is not None and self.global_costmap is None
+        if not (narrow and self._apart_for_the_circle(start)):
+            try:
+                path = self._plan_with(start, mark_scan, footprint=False)
+            except PlanningError:
+                if not narrow:
+                    raise
+            else:
+                self.footprint_plan = False
+                return path
+        path = self._plan_with(start, mark_scan, footprint=True)
+        self.footprint_plan = True
+        return path
+
+    def _apart_for_the_circle(self, start: Pose2D) -> bool:
+        """Whether start and goal lie in different free regions of :attr:`inflated`.
+
+        Then planning with the robot radius surely fails (a scan marked on the grid only blocks
+        more), so a replan in a narrow passage need not search the whole region first. The
+        8-connected regions are labelled once per map; a start in the inflated zone is not
+        judged (its way out is found by the planning).
+        """
+        assert self.inflated is not None
+        if self._wide_labels is None:
+            self._wide_labels = ndimage.label(
+                ~self.inflated.occupied, structure=np.ones((3, 3), dtype=bool)
+            )[0]
+        cells = self.inflated.world_to_cell(np.array([start.xy, self.goal.xy]))
+        if not bool(np.all(self.inflated.in_bounds(cells))):
+            return False
+        a, b = self._wide_labels[cells[:, 0], cells[:, 1]]
+        return bool(a > 0 and b > 0 and a != b)
+
+    def _plan_with(
+        self, start: Pose2D, mark_scan: bool, *, footprint: bool
+    ) -> NDArray[np.float64]:
         assert self.inflated is not None
         assert self.grid is not None
-        grid, costmap = self._planning_grid(mark_scan)
+        grid, costmap = self._planning_grid(mark_scan, footprint=footprint)
         try:
             return self._plan_on(grid, costmap, start)
         except StartOccupied:
@@ -999,13 +1112,15 @@ class NavigationStack:
         blocked = grid.occupied
         if not bool(grid.in_bounds(cell)) or bool(blocked.all()):
             return None
-        if grid is self.inflated and self._nearest_free is not None:
-            idx = self._nearest_free
+        # The inflated maps (not those with a scan marked) keep their nearest-free-cell table.
+        key = 0 if grid is self.inflated else 1 if grid is self.inflated_footprint else -1
+        if key in self._nearest_free:
+            idx = self._nearest_free[key]
         else:
             # One EDT with indices gives every cell's nearest free cell; computed on first need.
             _, idx = ndimage.distance_transform_edt(blocked, return_indices=True)
-            if grid is self.inflated:
-                self._nearest_free = idx
+            if key >= 0:
+                self._nearest_free[key] = idx
         r, c = int(cell[0]), int(cell[1])
         free_cell = idx[:, r, c]
         centre = grid.cell_to_world(free_cell)

@@ -23,7 +23,13 @@ from pydantic import (
 )
 
 from arena.core.errors import ConfigError
-from arena.core.geometry import bounding_radius, polygon_area
+from arena.core.geometry import (
+    bounding_radius,
+    convex_hull,
+    point_segment_distance,
+    points_in_polygon,
+    polygon_area,
+)
 from arena.robots.kinematics import KINEMATICS, Kinematics
 from arena.robots.limits import VelocityLimits
 from arena.sensors.spec import LidarSpec
@@ -209,6 +215,21 @@ class RobotModel(BaseModel):
         if isinstance(self.footprint, CircleFootprint):
             return float(self.footprint.radius)
         return bounding_radius(np.asarray(self.footprint.points, dtype=np.float64))
+
+    @property
+    def inscribed_radius(self) -> float:
+        """Radius of the largest circle about the robot origin inside the footprint (m).
+
+        The distance from the origin to the nearest footprint edge (of the convex hull, as
+        collisions use it); 0 when the origin lies outside the footprint.
+        """
+        if isinstance(self.footprint, CircleFootprint):
+            return float(self.footprint.radius)
+        hull = convex_hull(np.asarray(self.footprint.points, dtype=np.float64))
+        if not bool(points_in_polygon(np.zeros((1, 2)), hull)[0]):
+            return 0.0
+        d = point_segment_distance(np.zeros((1, 2)), hull, np.roll(hull, -1, axis=0))
+        return float(np.min(d))
 
 
 def check_actions(actions: Actions, limits: VelocityLimits, *, holonomic: bool) -> None:

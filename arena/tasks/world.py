@@ -377,6 +377,7 @@ class WorldSampler:
         polygon: FloatArray | None = None,
         forbid: bool = True,
         max_tries: int = 2000,
+        at_most: bool = False,
     ) -> FloatArray:
         """``(n, 2)`` positions each keeping ``clearance`` (m) from walls, obstacles and zones.
 
@@ -396,9 +397,11 @@ class WorldSampler:
                 later positions keep away from it); positions of one call are always kept
                 ``2·clearance`` apart.
             max_tries: random candidates drawn before the exhaustive last attempt.
+            at_most: return as many positions as fit (``(k, 2)``, ``k ≤ n``) instead of
+                raising when fewer than ``n`` do.
 
         Raises:
-            SamplingError: if fewer than ``n`` admissible positions exist.
+            SamplingError: if fewer than ``n`` admissible positions exist (unless ``at_most``).
         """
         if n <= 0:
             return np.zeros((0, 2))
@@ -439,7 +442,10 @@ class WorldSampler:
         if count < n:
             if flat is None:
                 flat = np.flatnonzero(self.candidate_mask(clearance))
-            self._exhaustive(flat, shape, chosen, count, clearance, polygon, rng, what)
+            count = self._exhaustive(
+                flat, shape, chosen, count, clearance, polygon, rng, what, at_most=at_most
+            )
+            chosen = chosen[:count]
         if forbid:
             for p in chosen:
                 self.forbid(p, clearance)
@@ -465,10 +471,13 @@ class WorldSampler:
         polygon: FloatArray | None,
         rng: np.random.Generator,
         what: str,
-    ) -> None:
+        *,
+        at_most: bool = False,
+    ) -> int:
         """Last attempt: every candidate cell centre in random order (fails only if none fit).
 
-        Fills ``chosen`` ``(n, 2)`` beyond its first ``count`` rows, in place. The candidates
+        Fills ``chosen`` ``(n, 2)`` beyond its first ``count`` rows, in place, and returns the
+        rows filled (``n``, or fewer with ``at_most`` instead of raising). The candidates
         are tested in chunks, in that order, up to the one that completes ``chosen``: a
         request for one position (each placed obstacle) rarely needs more than the first.
         """
@@ -483,7 +492,9 @@ class WorldSampler:
                 ok = self._admissible(pts, clearance, polygon)
                 count = accept_spaced(np.ascontiguousarray(pts[ok]), chosen, count, 2 * clearance)
                 if count == n:
-                    return
+                    return count
+        if at_most:
+            return count
         raise SamplingError(
             f"cannot place {what}: found room for {count} of {n} with clearance "
             f"{clearance:g} m from walls, obstacles and forbidden zones "

@@ -8,12 +8,15 @@ robots' start and goal zones. Pedestrians start ``agent_robot_clearance`` away f
 start and walk round trips between waypoints that see each other (so even a model that
 ignores walls never walks through one); Arena instead draws two unconstrained waypoints.
 Interactive obstacles are placed like static ones: the 2-D backend has no pushable bodies.
+A count that does not fit is an error, or with ``when_full: fewer`` (the demo preset, so that
+``arena run --map`` works on a user's small map) as many as fit, after one warning per map.
 """
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numba import njit
@@ -133,9 +136,14 @@ class RandomObstacles:
         elder_fraction: float = Field(
             0.2, ge=0, le=1, description="share of elder pedestrians (Arena's crowdsim: 0.2)"
         )
+        when_full: Literal["error", "fewer"] = Field(
+            "error", description="when an obstacle or pedestrian finds no room: error, or "
+            "place fewer with a warning (the demo preset, on a user's small map)"
+        )
 
     def __init__(self, params: Params | None = None) -> None:
         self.params = params or self.Params()
+        self._warned: set[str] = set()
 
     def reset(self, ctx: ResetContext) -> tuple[list[Obstacle], AgentSpawn]:
         """Obstacles, then pedestrians, each class with its own random stream."""
@@ -150,10 +158,14 @@ class RandomObstacles:
             field = f"task.obstacles.{cls}"
             if override is not None:
                 field = f"the curriculum stage's {cls} count (overriding {field})"
-            placed += place_obstacles(ctx, prefix, n, count.models, rng, p, field=field)
+            placed += place_obstacles(
+                ctx, prefix, n, count.models, rng, p, field=field,
+                fewer=self._warned if p.when_full == "fewer" else None,
+            )
         n_agents = p.dynamic.draw(rng, ctx.counts.dynamic)
         return placed, place_pedestrians(
-            ctx, n_agents, placed, ctx.rng("pedestrians"), p, elder_fraction=p.elder_fraction
+            ctx, n_agents, placed, ctx.rng("pedestrians"), p, elder_fraction=p.elder_fraction,
+            fewer=self._warned if p.when_full == "fewer" else None,
         )
 
 
@@ -168,13 +180,16 @@ def place_obstacles(
     *,
     counter: dict[str, int] | None = None,
     field: str = "the obstacle count",
+    fewer: set[str] | None = None,
 ) -> list[Obstacle]:
     """Place ``n`` obstacles drawn uniformly from ``models`` and add them to ``ctx.sampler``.
 
     Each keeps ``params.obstacle_clearance`` (m) beyond its circumscribed radius from walls,
     obstacles and forbidden zones. Names are ``<prefix>_<model>_<k>`` (``k`` from 1 per model);
     ``counter`` (``"<prefix>_<model>"`` → last ``k``) continues the numbering across calls.
-    ``field`` names where ``n`` came from, for errors.
+    ``field`` names where ``n`` came from, for errors. With ``fewer`` (a set of the warnings
+    given so far, to which a new one is added: one per map and run) a request that does not fit
+    places as many as do, after a warning, instead of raising.
 
     Raises:
         SamplingError: at once (no draw made) if ``n`` exceeds :func:`obstacle_capacity`, or
@@ -182,6 +197,9 @@ def place_obstacles(
     """
     p = params
     fit = obstacle_capacity(ctx.map.grid, models, p)
+    wanted = n
+    if fewer is not None:
+        n = min(n, fit)
     if n > fit:
         raise SamplingError(
             f"{field}: {n} obstacles cannot fit on map {ctx.map.name!r}: at most ~{fit} fit "
@@ -217,6 +235,8 @@ def place_obstacles(
             else:
                 ob = make_obstacle(name, model, pose)
             break
+        if ob is None and fewer is not None:
+            break
         if ob is None:
             tries = f" in {p.max_attempts} sizes" if model == BOX else ""
             raise SamplingError(
@@ -227,7 +247,27 @@ def place_obstacles(
             )
         ctx.sampler.add_obstacles([ob])
         out.append(ob)
+    if fewer is not None and len(out) < wanted:
+        _warn_fewer(ctx, field, wanted, p, fewer)
     return out
+
+
+def _warn_fewer(
+    ctx: ResetContext, field: str, n: int, p: PlacementParams, warned: set[str],
+    *, what: str = "obstacles",
+) -> None:
+    """Warn (once per map and run) that fewer than ``n`` obstacles (or pedestrians) fit."""
+    room = (
+        f"with a free gap of {p.obstacle_clearance:g} m around each" if what == "obstacles"
+        else "clear of walls, obstacles and the robots' starts"
+    )
+    text = (
+        f"map {ctx.map.name!r}: {field}: not all {n} {what} fit {room}; placed as many as "
+        "did (when_full: error makes it an error)"
+    )
+    if text not in warned:
+        warned.add(text)
+        warnings.warn(text, UserWarning, stacklevel=3)
 
 
 def obstacle_capacity(grid: OccupancyGrid, models: Sequence[str], params: PlacementParams) -> int:
@@ -292,6 +332,7 @@ def place_pedestrians(
     *,
     kinds: NDArray[np.int64] | None = None,
     elder_fraction: float = 0.0,
+    fewer: set[str] | None = None,
 ) -> AgentSpawn:
     """``n`` pedestrians on round trips between mutually visible waypoints.
 
@@ -307,6 +348,8 @@ def place_pedestrians(
         kinds: ``(n,)`` type codes (0 adult, 1 elder, 2 child); ``None`` draws elders with
             probability ``elder_fraction`` (after all other draws).
         elder_fraction: share of elders when ``kinds`` is ``None``.
+        fewer: as in :func:`place_obstacles`: place as many starts as fit, after a warning
+            (added to this set of those given), instead of raising.
     """
     p = params
     if n == 0:
@@ -319,7 +362,13 @@ def place_pedestrians(
     # Starts keep agent_robot_clearance from every robot start (beyond the robot's body).
     for r in ctx.spawns:
         world.forbid(r.start.xy, spawn_radius(r.model) + p.agent_robot_clearance)
-    starts = world.sample(n, body, rng, what=f"{n} pedestrians")
+    starts = world.sample(n, body, rng, what=f"{n} pedestrians", at_most=fewer is not None)
+    if fewer is not None and len(starts) < n:
+        _warn_fewer(ctx, "task.obstacles.dynamic", n, p, fewer, what="pedestrians")
+        n = len(starts)
+        kinds = None if kinds is None else kinds[:n]
+        if n == 0:
+            return AgentSpawn.empty()
     walkable = walkable_mask(grid, ctx.map.obstacles, placed, body)
     k = p.agent_waypoints
     # Round trip start → w1 → … → wk → … → w1 → start, so a loop never crosses a wall.
