@@ -468,9 +468,10 @@ def _write_video(
     cfg, backend, states, path, goal, out_dir: Path, outcome: Outcome, episode: Episode
 ) -> dict[str, str]:
     # Imported here: rendering is optional and the only user of matplotlib.
-    from arena.render import FrameRenderer, Overlay, VideoWriter, save_png
+    from arena.render import FrameRenderer, Overlay, VideoWriter, legend_items, save_png
 
     robot_specs = [spawn.model.laser for spawn in episode.robots]
+    goals = goal.as_array()[None, :]
     renderer = FrameRenderer(
         backend.world,
         lidar_specs=robot_specs,
@@ -479,10 +480,13 @@ def _write_video(
             t for t in (run_name(cfg), episode.label, states[0].robots.models[0], cfg.crowd["type"])
             if t
         ),
-        legend=len(states[0].agents) > 0,
+        # a key to exactly what the video shows (its social states, a collision if one happens)
+        legend=legend_items(
+            states, [Overlay(paths=[path], goals=goals)],
+            lidar=any(spec is not None for spec in robot_specs), trails=True,
+        ),
     )
     video_path = out_dir / f"video.{cfg.output.video_format}"
-    goals = goal.as_array()[None, :]
     fps = 1.0 / cfg.sim.dt / cfg.output.frame_every
     frame = None
     with VideoWriter(video_path, fps=fps) as writer:

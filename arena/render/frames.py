@@ -27,18 +27,20 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
+from matplotlib.transforms import Bbox
 from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import ConfigError
 from arena.core.geometry import regular_polygon, transform_points
 from arena.maps.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from arena.render import style
+from arena.render.legend import DPI, draw_legend, legend_entries, legend_size, text_size
 from arena.sensors.spec import LidarSpec
 from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 
 FloatArray = NDArray[np.float64]
 
-_DPI = 100.0
+_DPI = DPI
 # Tiny extra canvas size so that ``int(inches · dpi)`` never truncates to one pixel too few.
 _PAD_PX = 1e-3
 _ROBOT_CIRCLE_SIDES = 40
@@ -48,6 +50,19 @@ _SCALE_STEPS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 50
 
 MAX_WIDTH_PX = 8000
 """Widest frame drawn (pixels): an 8K image; wider ones take gigabytes for nothing."""
+
+DEFAULT_WIDTH_PX = 800
+"""Frame width (pixels) of videos and stills unless asked otherwise: text and the legend stay
+readable in a report or on a slide."""
+
+# Text sizes relative to the frame's base font (:func:`_font_size`), and the padding of the
+# white boxes behind texts (a fraction of their font size, matplotlib's ``pad``).
+_TITLE_FONT = 1.15
+_LEGEND_FONT = 0.9
+_BOX_PAD = 0.3
+# The longest usual time line (``run_episode``'s, with an outcome): the title shares the top
+# line with it only where both fit.
+_HUD_SAMPLE = "t = 000.0 s   step 0000   collision"
 
 
 @dataclass(frozen=True)
@@ -82,18 +97,26 @@ class FrameRenderer:
         world: the map and placed obstacles; drawn once.
         lidar_specs: per robot index the lidar that produced ``RobotStates.scans[i]``, or
             ``None`` for robots whose scans should not be drawn. Missing entries count as ``None``.
-        width_px: frame width in pixels; the height follows from the view's aspect ratio.
+        width_px: frame width in pixels; the height follows from the view's aspect ratio, up to
+            ``max_height_px``.
         show_lidar: draw lidar hit points and the scanned area as a faint fan.
         show_trails: draw each robot's past positions (recorded across :meth:`render` calls, or
             taken from :attr:`Overlay.trails`).
-        title: text shown at the top right of every frame.
+        title: text shown at the top right of every frame (shortened with "…" where it would
+            not fit; on a line of its own under the time line where both do not fit on one).
         margin_m: extra space around the map and obstacles (m).
         trail_length: how many past positions a recorded trail keeps.
-        legend: draw the pedestrian social-state colour legend (bottom right, in its own
-            column right of the map; the frame is then at least as tall as the legend).
+        legend: the legend's entries (names from :data:`arena.render.legend.ELEMENTS` and
+            social-state names, see :func:`arena.render.legend.legend_items`), ``True`` for all
+            of them, ``False`` or empty for none. It is drawn bottom right in a column of its
+            own right of the map, so it never hides the map; the frame is at least as tall as it.
+        max_height_px: the tallest frame (pixels, default ``width_px``): a map taller than that
+            is scaled down to fit and centred, so a long corridor standing upright does not
+            give a frame thousands of pixels tall.
 
     Raises:
-        ConfigError: ``width_px`` is too small or ``margin_m`` negative.
+        ConfigError: ``width_px`` out of range or too narrow for the legend, ``max_height_px``
+            below 16, ``margin_m`` negative, or an unknown legend entry.
     """
 
     def __init__(
@@ -101,28 +124,34 @@ class FrameRenderer:
         world: StaticWorld,
         *,
         lidar_specs: Sequence[LidarSpec | None] = (),
-        width_px: int = 800,
+        width_px: int = DEFAULT_WIDTH_PX,
         show_lidar: bool = True,
         show_trails: bool = True,
         title: str = "",
         margin_m: float = 0.0,
         trail_length: int = 600,
-        legend: bool = False,
+        legend: bool | Sequence[str] = False,
+        max_height_px: int | None = None,
     ) -> None:
         if not 16 <= width_px <= MAX_WIDTH_PX:
             raise ConfigError(
                 f"width_px must lie in [16, {MAX_WIDTH_PX}] pixels, got {width_px}"
             )
+        max_h = int(width_px) if max_height_px is None else int(max_height_px)
+        if not 16 <= max_h <= MAX_WIDTH_PX:
+            raise ConfigError(
+                f"max_height_px must lie in [16, {MAX_WIDTH_PX}] pixels, got {max_height_px}"
+            )
         if margin_m < 0:
             raise ConfigError(f"margin_m must be >= 0 m, got {margin_m}")
         self.world = world
-        self.legend = legend
+        self.legend: tuple[str, ...] = legend_entries(legend)
         self.lidar_specs: tuple[LidarSpec | None, ...] = tuple(lidar_specs)
         self.show_lidar = show_lidar
         self.show_trails = show_trails
-        self.title = title
         self._trail: deque[FloatArray] = deque(maxlen=max(int(trail_length), 1))
         self._trail_key: tuple[tuple[str, ...], int] | None = None
+        self.width_px = int(width_px)
 
         # -- view: map ∪ obstacles, padded; scale s (px/m) is the same on both axes.
         xmin, ymin, xmax, ymax = world.grid.bounds
@@ -132,16 +161,26 @@ class FrameRenderer:
             xmax, ymax = max(xmax, float(poly[:, 0].max())), max(ymax, float(poly[:, 1].max()))
         xmin, ymin, xmax, ymax = xmin - margin_m, ymin - margin_m, xmax + margin_m, ymax + margin_m
         # The legend gets its own column right of the map (it must never hide the map, e.g. the
-        # goal at the end of a long corridor), and the frame is tall enough for it and the title.
-        legend_w, legend_h = _legend_extent(width_px) if legend else (0.0, 0.0)
-        self.scale = (float(width_px) - legend_w) / (xmax - xmin)
-        if title or legend:  # a strip above the map for the title and the time line
-            ymax += _title_height(width_px) / self.scale
-        height_px = max(2, math.ceil((ymax - ymin) * self.scale - 1e-6))
-        if legend:
-            height_px = max(height_px, math.ceil(legend_h + _title_height(width_px)))
+        # goal at the end of a long corridor), measured from its text so nothing is clipped.
+        legend_w, legend_h = legend_size(self.legend, self._legend_font())
+        if legend_w > 0.5 * width_px:
+            raise ConfigError(
+                f"width_px {width_px} is too narrow for a legend of {len(self.legend)} entries "
+                f"({legend_w:.0f} px wide); use width_px >= {math.ceil(2 * legend_w)}"
+            )
+        self.title, self._title_rows = self._fit_title(title)
+        # a strip above the map for the title and the time line
+        strip = 4.0 + self._title_rows * _strip_row(width_px) if (title or self.legend) else 0.0
+        self._strip_px = strip
+        map_w = float(width_px) - legend_w  # the map area: left of the legend, under the strip
+        self.scale = map_w / (xmax - xmin)
+        if (ymax - ymin) * self.scale + strip > max_h:
+            self.scale = max(max_h - strip, 8.0) / (ymax - ymin)
+        height_px = max(2, math.ceil((ymax - ymin) * self.scale + strip - 1e-6),
+                        math.ceil(legend_h + strip))
         height_px += height_px % 2
-        self.width_px, self.height_px = int(width_px), int(height_px)
+        self.height_px = int(height_px)
+        self._legend_w = legend_w
 
         self._fig = Figure(
             figsize=((self.width_px + _PAD_PX) / _DPI, (self.height_px + _PAD_PX) / _DPI), dpi=_DPI
@@ -152,11 +191,12 @@ class FrameRenderer:
         ax.set_axis_off()
         ax.set_facecolor(style.BACKGROUND)
         # Fix the limits from the real canvas size so both axes get exactly ``scale`` px/m. The
-        # extra height from rounding up is split evenly above and below; the sub-pixel pad lies
-        # past the right and bottom edges, which the pixel buffer cuts off.
+        # map is centred in its area (left of the legend, under the strip); the sub-pixel pad
+        # lies past the right and top edges, which the pixel buffer cuts off.
         bw, bh = self._fig.bbox.width, self._fig.bbox.height
-        ytop = 0.5 * (ymin + ymax) + 0.5 * self.height_px / self.scale
-        self._xlim = (xmin, xmin + bw / self.scale)
+        x0 = 0.5 * (xmin + xmax) - 0.5 * map_w / self.scale
+        ytop = 0.5 * (ymin + ymax) + (strip + 0.5 * (self.height_px - strip)) / self.scale
+        self._xlim = (x0, x0 + bw / self.scale)
         self._ylim = (ytop - bh / self.scale, ytop)
         ax.set_xlim(*self._xlim)
         ax.set_ylim(*self._ylim)
@@ -262,80 +302,51 @@ class FrameRenderer:
                 )
             )
         self._draw_scale_bar()
-        if self.legend:
-            self._draw_legend()
-        fontsize = self._font_size()
+        box = draw_legend(ax, self.legend, self._legend_font(), self.width_px) if self.legend else (
+            self.width_px, 0.0, self.width_px, 0.0)
+        # as (col0, row0, col1, row1) frame pixels, row 0 at the top
+        self.legend_box = (box[0], self.height_px - box[3], box[2], self.height_px - box[1])
         if self.title:
             # Top right: the top-left corner holds the time line.
             ax.text(
                 1.0 - 8.0 / self.width_px,
-                1.0 - 8.0 / self.height_px,
+                self._line_top(self._title_rows - 1),
                 self.title,
                 transform=ax.transAxes,
                 ha="right",
                 va="top",
-                fontsize=fontsize * 1.15,
+                fontsize=self._font_size() * _TITLE_FONT,
                 color=style.TEXT,
                 zorder=20,
                 bbox=self._text_box(),
+                parse_math=False,
             )
 
-    def _draw_legend(self) -> None:
-        """Social-state colours, bottom right, in one boxed column of coloured dots.
+    def _line_top(self, k: int) -> float:
+        """Axes ``y`` of the top of text line ``k`` of the strip (0: the top line)."""
+        pad = _BOX_PAD * self._font_size() * _TITLE_FONT * _DPI / 72.0
+        return 1.0 - (4.0 + pad + k * _strip_row(self.width_px)) / self.height_px
 
-        Drawn under robots, goals and people (above the map) so it never hides them.
-        """
-        ax = self._ax
-        fs = self._font_size() * 0.8
-        line = fs * 1.45 / 72.0 * _DPI  # pixels per legend row
-        names = style.AGENT_STATE_NAMES
-        x = 1.0 - 8.0 / self.width_px
-        for k, name in enumerate(reversed(names)):
-            code = len(names) - 1 - k
-            y = (8.0 + line * (k + 0.5)) / self.height_px
-            ax.text(
-                x,
-                y,
-                f"{name} \u25cf",
-                transform=ax.transAxes,
-                ha="right",
-                va="center",
-                fontsize=fs,
-                color=style.TEXT,
-                zorder=1.6,
-            )
-            ax.text(
-                x,
-                y,
-                "\u25cf",
-                transform=ax.transAxes,
-                ha="right",
-                va="center",
-                fontsize=fs,
-                color=style.AGENT_STATE_COLORS[code],
-                zorder=1.7,
-            )
-        top = (8.0 + line * len(names)) / self.height_px
-        left = 1.0 - (8.0 + fs * 7.5 / 72.0 * _DPI) / self.width_px
-        ax.add_patch(
-            Rectangle(
-                (left, 4.0 / self.height_px),
-                1.0 - left - 4.0 / self.width_px,
-                top - 2.0 / self.height_px,
-                transform=ax.transAxes,
-                facecolor=style.TEXT_BOX,
-                alpha=style.TEXT_BOX_ALPHA,
-                edgecolor="none",
-                zorder=1.5,
-            )
-        )
+    def _legend_font(self) -> float:
+        return self._font_size() * _LEGEND_FONT
+
+    def _fit_title(self, title: str) -> tuple[str, int]:
+        """The title as drawn (shortened to the frame width) and the strip's number of lines."""
+        if not title:
+            return "", 1
+        size = self._font_size() * _TITLE_FONT
+        pad = 2 * _BOX_PAD * size * _DPI / 72.0
+        title = _shorten(title, size, self.width_px - 16.0 - pad)
+        hud = text_size(_HUD_SAMPLE, self._font_size(), family="monospace")[0]
+        hud += 2 * _BOX_PAD * self._font_size() * _DPI / 72.0
+        return title, 1 if text_size(title, size)[0] + pad + hud + 24.0 <= self.width_px else 2
 
     def _font_size(self) -> float:
         return _font_size(self.width_px)
 
     def _text_box(self) -> dict[str, object]:
         return {
-            "boxstyle": "round,pad=0.3",
+            "boxstyle": f"round,pad={_BOX_PAD}",
             "facecolor": style.TEXT_BOX,
             "alpha": style.TEXT_BOX_ALPHA,
             "edgecolor": "none",
@@ -450,7 +461,7 @@ class FrameRenderer:
         )
         self._hud = ax.text(
             8.0 / self.width_px,
-            1.0 - 8.0 / self.height_px,
+            self._line_top(0),
             "",
             transform=ax.transAxes,
             ha="left",
@@ -460,6 +471,7 @@ class FrameRenderer:
             color=style.TEXT,
             zorder=20,
             bbox=self._text_box(),
+            parse_math=False,
         )
         for coll in (
             self._fans,
@@ -489,9 +501,16 @@ class FrameRenderer:
             ),
             key=lambda a: a.get_zorder(),
         )
+        # Robots, people and scans stay in the map area: never over the legend or the strip.
+        map_area = Bbox.from_extents(
+            0.0, 0.0, self.width_px - self._legend_w, self.height_px - self._strip_px
+        )
         for artist in self._dynamic:
             # Animated artists are left out of canvas.draw(): the background stays static.
             artist.set_animated(True)
+            if artist is not self._hud:
+                artist.set_clip_box(map_area)
+                artist.set_clip_on(True)
         self._agent_circle = regular_polygon(1.0, _AGENT_CIRCLE_SIDES)
         # Goal arrow in pixels (shaft, head), converted to metres once: it is a marker, not a
         # physical object, so it keeps its size on screen whatever the map size.
@@ -673,16 +692,19 @@ def _font_size(width_px: float) -> float:
     return float(np.clip(width_px / 75.0, 7.0, 16.0))
 
 
-def _legend_extent(width_px: float) -> tuple[float, float]:
-    """``(width, height)`` px of the social-state legend box plus its 8 px margins."""
-    fs = _font_size(width_px) * 0.8
-    line = fs * 1.45 / 72.0 * _DPI
-    return 16.0 + fs * 7.5 / 72.0 * _DPI, 16.0 + line * len(style.AGENT_STATE_NAMES)
+def _strip_row(width_px: float) -> float:
+    """Pixels per line of the strip above the map: a title box (the largest text) and a gap."""
+    title_pt = _TITLE_FONT * _font_size(width_px)
+    return (1.25 + 2 * _BOX_PAD) * title_pt * _DPI / 72.0 + 6.0
 
 
-def _title_height(width_px: float) -> float:
-    """Pixels taken by the title line at the top (with its box and margin)."""
-    return 16.0 + _font_size(width_px) * 1.45 / 72.0 * _DPI
+def _shorten(text: str, size_pt: float, width: float) -> str:
+    """``text``, cut and ended with "…" where needed so that it is at most ``width`` px wide."""
+    if text_size(text, size_pt)[0] <= width:
+        return text
+    while len(text) > 1 and text_size(text + "\u2026", size_pt)[0] > width:
+        text = text[:-1]
+    return text.rstrip() + "\u2026"
 
 
 def _rgba_to_rgb(rgba: NDArray[np.uint8]) -> NDArray[np.uint8]:
@@ -757,7 +779,9 @@ def _map_image(
     return image, extent
 
 
-def render_world(world: StaticWorld, *, width_px: int = 800, title: str = "") -> NDArray[np.uint8]:
+def render_world(
+    world: StaticWorld, *, width_px: int = DEFAULT_WIDTH_PX, title: str = ""
+) -> NDArray[np.uint8]:
     """A top-down picture of a world with no robots or people (map previews, galleries)."""
     robots = RobotStates(
         (), (), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), (), ()
