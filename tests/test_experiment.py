@@ -279,4 +279,5 @@ def test_video_is_readable_and_its_legend_lists_what_it_shows(tmp_path, monkeypa
     # each frame shows the plan of its time: the first one starts where the robot starts
     (start, first), (end, final) = plans[0], plans[-1]
     assert np.hypot(*(first[0] - start)) < 0.3
-    assert np.hypot(*(end - start)) > 1.0  # the robot drove off (so a frame's plan matters)
+    assert np.hypot(*(end - start)) > 1.0  # the robot drove off
+    assert np.hypot(*(final[0] - start)) > 1.0  # and replanned: the last frame's plan is newer
