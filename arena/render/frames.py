@@ -51,6 +51,9 @@ _SCALE_STEPS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 50
 MAX_WIDTH_PX = 8000
 """Widest frame drawn (pixels): an 8K image; wider ones take gigabytes for nothing."""
 
+KNOWN_MARGIN_M = 1.0
+"""Unknown space shown around the mapped part of a map (m), so its outer walls keep a border."""
+
 DEFAULT_WIDTH_PX = 800
 """Frame width (pixels) of videos and stills unless asked otherwise: text and the legend stay
 readable in a report or on a slide."""
@@ -113,6 +116,9 @@ class FrameRenderer:
         max_height_px: the tallest frame (pixels, default ``width_px``): a map taller than that
             is scaled down to fit and centred, so a long corridor standing upright does not
             give a frame thousands of pixels tall.
+        crop_unknown: show only the mapped part of the map (cells not unknown, plus
+            :data:`KNOWN_MARGIN_M`): a building in the middle of a large unknown map fills the
+            frame instead of a small part of it.
 
     Raises:
         ConfigError: ``width_px`` out of range or too narrow for the legend, ``max_height_px``
@@ -132,6 +138,7 @@ class FrameRenderer:
         trail_length: int = 600,
         legend: bool | Sequence[str] = False,
         max_height_px: int | None = None,
+        crop_unknown: bool = True,
     ) -> None:
         if not 16 <= width_px <= MAX_WIDTH_PX:
             raise ConfigError(
@@ -154,7 +161,7 @@ class FrameRenderer:
         self.width_px = int(width_px)
 
         # -- view: map ∪ obstacles, padded; scale s (px/m) is the same on both axes.
-        xmin, ymin, xmax, ymax = world.grid.bounds
+        xmin, ymin, xmax, ymax = _known_bounds(world.grid) if crop_unknown else world.grid.bounds
         for ob in world.obstacles:
             poly = ob.polygon
             xmin, ymin = min(xmin, float(poly[:, 0].min())), min(ymin, float(poly[:, 1].min()))
@@ -690,6 +697,25 @@ class FrameRenderer:
 def _font_size(width_px: float) -> float:
     """Font size (pt): readable at 400 px wide, not huge at 1600 px."""
     return float(np.clip(width_px / 75.0, 7.0, 16.0))
+
+
+def _known_bounds(grid: OccupancyGrid) -> tuple[float, float, float, float]:
+    """``(xmin, ymin, xmax, ymax)`` (m) of the cells that are not unknown, padded.
+
+    The padding is :data:`KNOWN_MARGIN_M`, within the map; the whole map if every cell is unknown.
+    """
+    known = grid.data != UNKNOWN
+    rows, cols = np.flatnonzero(known.any(axis=1)), np.flatnonzero(known.any(axis=0))
+    if rows.size == 0:
+        return grid.bounds
+    (ox, oy), res = grid.origin, grid.resolution
+    x0, y0, x1, y1 = grid.bounds
+    return (
+        max(x0, ox + cols[0] * res - KNOWN_MARGIN_M),
+        max(y0, oy + rows[0] * res - KNOWN_MARGIN_M),
+        min(x1, ox + (cols[-1] + 1) * res + KNOWN_MARGIN_M),
+        min(y1, oy + (rows[-1] + 1) * res + KNOWN_MARGIN_M),
+    )
 
 
 def _strip_row(width_px: float) -> float:
