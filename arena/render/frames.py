@@ -16,7 +16,6 @@ open figure registry is involved.
 
 from __future__ import annotations
 
-import math
 import sys
 from collections import deque
 from collections.abc import Sequence
@@ -26,15 +25,21 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
 from matplotlib.transforms import Bbox
 from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import ConfigError
 from arena.core.geometry import regular_polygon, transform_points
-from arena.maps.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from arena.render import style
-from arena.render.legend import DPI, draw_legend, legend_entries, legend_size, text_size
+from arena.render.layout import (
+    BOX_PAD,
+    LEGEND_FONT,
+    TITLE_FONT,
+    font_size,
+    frame_layout,
+)
+from arena.render.legend import DPI, draw_legend, legend_entries
+from arena.render.mapview import draw_scale_bar, map_image
 from arena.sensors.spec import LidarSpec
 from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 
@@ -45,27 +50,11 @@ _DPI = DPI
 _PAD_PX = 1e-3
 _ROBOT_CIRCLE_SIDES = 40
 _AGENT_CIRCLE_SIDES = 24
-_SCALE_STEPS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0)
 
-
-MAX_WIDTH_PX = 8000
-"""Widest frame drawn (pixels): an 8K image; wider ones take gigabytes for nothing."""
-
-KNOWN_MARGIN_M = 1.0
-"""Unknown space shown around the mapped part of a map (m), so its outer walls keep a border."""
 
 DEFAULT_WIDTH_PX = 800
 """Frame width (pixels) of videos and stills unless asked otherwise: text and the legend stay
 readable in a report or on a slide."""
-
-# Text sizes relative to the frame's base font (:func:`_font_size`), and the padding of the
-# white boxes behind texts (a fraction of their font size, matplotlib's ``pad``).
-_TITLE_FONT = 1.15
-_LEGEND_FONT = 0.9
-_BOX_PAD = 0.3
-# The longest usual time line (``run_episode``'s, with an outcome): the title shares the top
-# line with it only where both fit.
-_HUD_SAMPLE = "t = 000.0 s   step 0000   collision"
 
 
 @dataclass(frozen=True)
@@ -117,8 +106,8 @@ class FrameRenderer:
             is scaled down to fit and centred, so a long corridor standing upright does not
             give a frame thousands of pixels tall.
         crop_unknown: show only the mapped part of the map (cells not unknown, plus
-            :data:`KNOWN_MARGIN_M`): a building in the middle of a large unknown map fills the
-            frame instead of a small part of it.
+            :data:`arena.render.layout.KNOWN_MARGIN_M`): a building in the middle of a large
+            unknown map fills the frame instead of a small part of it.
 
     Raises:
         ConfigError: ``width_px`` out of range or too narrow for the legend, ``max_height_px``
@@ -140,17 +129,6 @@ class FrameRenderer:
         max_height_px: int | None = None,
         crop_unknown: bool = True,
     ) -> None:
-        if not 16 <= width_px <= MAX_WIDTH_PX:
-            raise ConfigError(
-                f"width_px must lie in [16, {MAX_WIDTH_PX}] pixels, got {width_px}"
-            )
-        max_h = int(width_px) if max_height_px is None else int(max_height_px)
-        if not 16 <= max_h <= MAX_WIDTH_PX:
-            raise ConfigError(
-                f"max_height_px must lie in [16, {MAX_WIDTH_PX}] pixels, got {max_height_px}"
-            )
-        if margin_m < 0:
-            raise ConfigError(f"margin_m must be >= 0 m, got {margin_m}")
         self.world = world
         self.legend: tuple[str, ...] = legend_entries(legend)
         self.lidar_specs: tuple[LidarSpec | None, ...] = tuple(lidar_specs)
@@ -158,36 +136,13 @@ class FrameRenderer:
         self.show_trails = show_trails
         self._trail: deque[FloatArray] = deque(maxlen=max(int(trail_length), 1))
         self._trail_key: tuple[tuple[str, ...], int] | None = None
-        self.width_px = int(width_px)
-
-        # -- view: map ∪ obstacles, padded; scale s (px/m) is the same on both axes.
-        xmin, ymin, xmax, ymax = _known_bounds(world.grid) if crop_unknown else world.grid.bounds
-        for ob in world.obstacles:
-            poly = ob.polygon
-            xmin, ymin = min(xmin, float(poly[:, 0].min())), min(ymin, float(poly[:, 1].min()))
-            xmax, ymax = max(xmax, float(poly[:, 0].max())), max(ymax, float(poly[:, 1].max()))
-        xmin, ymin, xmax, ymax = xmin - margin_m, ymin - margin_m, xmax + margin_m, ymax + margin_m
-        # The legend gets its own column right of the map (it must never hide the map, e.g. the
-        # goal at the end of a long corridor), measured from its text so nothing is clipped.
-        legend_w, legend_h = legend_size(self.legend, self._legend_font())
-        if legend_w > 0.5 * width_px:
-            raise ConfigError(
-                f"width_px {width_px} is too narrow for a legend of {len(self.legend)} entries "
-                f"({legend_w:.0f} px wide); use width_px >= {math.ceil(2 * legend_w)}"
-            )
-        self.title, self._title_rows = self._fit_title(title)
-        # a strip above the map for the title and the time line
-        strip = 4.0 + self._title_rows * _strip_row(width_px) if (title or self.legend) else 0.0
-        self._strip_px = strip
-        map_w = float(width_px) - legend_w  # the map area: left of the legend, under the strip
-        self.scale = map_w / (xmax - xmin)
-        if (ymax - ymin) * self.scale + strip > max_h:
-            self.scale = max(max_h - strip, 8.0) / (ymax - ymin)
-        height_px = max(2, math.ceil((ymax - ymin) * self.scale + strip - 1e-6),
-                        math.ceil(legend_h + strip))
-        height_px += height_px % 2
-        self.height_px = int(height_px)
-        self._legend_w = legend_w
+        self.layout = frame_layout(
+            world, width_px=width_px, max_height_px=max_height_px, margin_m=margin_m,
+            crop_unknown=crop_unknown, title=title, legend=self.legend,
+        )
+        self.width_px, self.height_px = self.layout.width_px, self.layout.height_px
+        self.scale = self.layout.scale
+        self.title = self.layout.title
 
         self._fig = Figure(
             figsize=((self.width_px + _PAD_PX) / _DPI, (self.height_px + _PAD_PX) / _DPI), dpi=_DPI
@@ -197,12 +152,10 @@ class FrameRenderer:
         ax = self._fig.add_axes((0.0, 0.0, 1.0, 1.0))
         ax.set_axis_off()
         ax.set_facecolor(style.BACKGROUND)
-        # Fix the limits from the real canvas size so both axes get exactly ``scale`` px/m. The
-        # map is centred in its area (left of the legend, under the strip); the sub-pixel pad
-        # lies past the right and top edges, which the pixel buffer cuts off.
+        # Fix the limits from the real canvas size so both axes get exactly ``scale`` px/m; the
+        # sub-pixel pad lies past the right and top edges, which the pixel buffer cuts off.
         bw, bh = self._fig.bbox.width, self._fig.bbox.height
-        x0 = 0.5 * (xmin + xmax) - 0.5 * map_w / self.scale
-        ytop = 0.5 * (ymin + ymax) + (strip + 0.5 * (self.height_px - strip)) / self.scale
+        x0, ytop = self.layout.left_m, self.layout.top_m
         self._xlim = (x0, x0 + bw / self.scale)
         self._ylim = (ytop - bh / self.scale, ytop)
         ax.set_xlim(*self._xlim)
@@ -294,7 +247,7 @@ class FrameRenderer:
 
     def _draw_static(self) -> None:
         ax, grid = self._ax, self.world.grid
-        image, extent = _map_image(grid, self.scale)
+        image, extent = map_image(grid, self.scale)
         ax.imshow(
             image, origin="lower", extent=extent, interpolation="nearest", resample=False, zorder=0
         )
@@ -308,8 +261,9 @@ class FrameRenderer:
                     zorder=1,
                 )
             )
-        self._draw_scale_bar()
-        box = draw_legend(ax, self.legend, self._legend_font(), self.width_px) if self.legend else (
+        draw_scale_bar(ax, self.extent, self.scale, self._font_size())
+        font = self._font_size() * LEGEND_FONT
+        box = draw_legend(ax, self.legend, font, self.width_px) if self.legend else (
             self.width_px, 0.0, self.width_px, 0.0)
         # as (col0, row0, col1, row1) frame pixels, row 0 at the top
         self.legend_box = (box[0], self.height_px - box[3], box[2], self.height_px - box[1])
@@ -317,12 +271,12 @@ class FrameRenderer:
             # Top right: the top-left corner holds the time line.
             ax.text(
                 1.0 - 8.0 / self.width_px,
-                self._line_top(self._title_rows - 1),
+                self._line_top(self.layout.title_line),
                 self.title,
                 transform=ax.transAxes,
                 ha="right",
                 va="top",
-                fontsize=self._font_size() * _TITLE_FONT,
+                fontsize=self._font_size() * TITLE_FONT,
                 color=style.TEXT,
                 zorder=20,
                 bbox=self._text_box(),
@@ -331,89 +285,18 @@ class FrameRenderer:
 
     def _line_top(self, k: int) -> float:
         """Axes ``y`` of the top of text line ``k`` of the strip (0: the top line)."""
-        pad = _BOX_PAD * self._font_size() * _TITLE_FONT * _DPI / 72.0
-        return 1.0 - (4.0 + pad + k * _strip_row(self.width_px)) / self.height_px
-
-    def _legend_font(self) -> float:
-        return self._font_size() * _LEGEND_FONT
-
-    def _fit_title(self, title: str) -> tuple[str, int]:
-        """The title as drawn (shortened to the frame width) and the strip's number of lines."""
-        if not title:
-            return "", 1
-        size = self._font_size() * _TITLE_FONT
-        pad = 2 * _BOX_PAD * size * _DPI / 72.0
-        title = _shorten(title, size, self.width_px - 16.0 - pad)
-        hud = text_size(_HUD_SAMPLE, self._font_size(), family="monospace")[0]
-        hud += 2 * _BOX_PAD * self._font_size() * _DPI / 72.0
-        return title, 1 if text_size(title, size)[0] + pad + hud + 24.0 <= self.width_px else 2
+        return 1.0 - self.layout.line_top_px(k) / self.height_px
 
     def _font_size(self) -> float:
-        return _font_size(self.width_px)
+        return font_size(self.width_px)
 
     def _text_box(self) -> dict[str, object]:
         return {
-            "boxstyle": f"round,pad={_BOX_PAD}",
+            "boxstyle": f"round,pad={BOX_PAD}",
             "facecolor": style.TEXT_BOX,
             "alpha": style.TEXT_BOX_ALPHA,
             "edgecolor": "none",
         }
-
-    def _draw_scale_bar(self) -> None:
-        ax, s = self._ax, self.scale
-        left, bottom, right, _ = self.extent
-        view_w = right - left
-        fits = [v for v in _SCALE_STEPS if v <= 0.2 * view_w]
-        length = fits[-1] if fits else view_w * 0.2
-        pad, bar_h = 12.0 / s, 5.0 / s
-        fontsize = self._font_size()
-        text_h = 1.6 * fontsize * _DPI / 72.0 / s
-        x0, y0 = left + pad, bottom + pad
-        ax.add_patch(
-            Rectangle(
-                (x0 - 0.5 * pad, y0 - 0.5 * pad),
-                length + pad,
-                bar_h + text_h + pad,
-                facecolor=style.TEXT_BOX,
-                alpha=style.TEXT_BOX_ALPHA,
-                edgecolor="none",
-                zorder=20,
-            )
-        )
-        # Half black, half white: the bar reads on both light and dark backgrounds.
-        ax.add_patch(
-            Rectangle(
-                (x0, y0),
-                length,
-                bar_h,
-                facecolor=style.TEXT,
-                edgecolor=style.TEXT,
-                linewidth=self._px(1.0),
-                zorder=21,
-            )
-        )
-        ax.add_patch(
-            Rectangle(
-                (x0 + 0.5 * length, y0),
-                0.5 * length,
-                bar_h,
-                facecolor="white",
-                edgecolor=style.TEXT,
-                linewidth=self._px(1.0),
-                zorder=22,
-            )
-        )
-        label = f"{length:g} m"
-        ax.text(
-            x0 + 0.5 * length,
-            y0 + bar_h + 2.0 / s,
-            label,
-            ha="center",
-            va="bottom",
-            fontsize=fontsize,
-            color=style.TEXT,
-            zorder=22,
-        )
 
     # -- dynamic artists ------------------------------------------------------------------------
     def _make_dynamic(self) -> None:
@@ -510,7 +393,7 @@ class FrameRenderer:
         )
         # Robots, people and scans stay in the map area: never over the legend or the strip.
         map_area = Bbox.from_extents(
-            0.0, 0.0, self.width_px - self._legend_w, self.height_px - self._strip_px
+            0.0, 0.0, self.width_px - self.layout.legend_px, self.height_px - self.layout.strip_px
         )
         for artist in self._dynamic:
             # Animated artists are left out of canvas.draw(): the background stays static.
@@ -694,45 +577,6 @@ class FrameRenderer:
         self._robot_heading.set_segments(heads)
 
 
-def _font_size(width_px: float) -> float:
-    """Font size (pt): readable at 400 px wide, not huge at 1600 px."""
-    return float(np.clip(width_px / 75.0, 7.0, 16.0))
-
-
-def _known_bounds(grid: OccupancyGrid) -> tuple[float, float, float, float]:
-    """``(xmin, ymin, xmax, ymax)`` (m) of the cells that are not unknown, padded.
-
-    The padding is :data:`KNOWN_MARGIN_M`, within the map; the whole map if every cell is unknown.
-    """
-    known = grid.data != UNKNOWN
-    rows, cols = np.flatnonzero(known.any(axis=1)), np.flatnonzero(known.any(axis=0))
-    if rows.size == 0:
-        return grid.bounds
-    (ox, oy), res = grid.origin, grid.resolution
-    x0, y0, x1, y1 = grid.bounds
-    return (
-        max(x0, ox + cols[0] * res - KNOWN_MARGIN_M),
-        max(y0, oy + rows[0] * res - KNOWN_MARGIN_M),
-        min(x1, ox + (cols[-1] + 1) * res + KNOWN_MARGIN_M),
-        min(y1, oy + (rows[-1] + 1) * res + KNOWN_MARGIN_M),
-    )
-
-
-def _strip_row(width_px: float) -> float:
-    """Pixels per line of the strip above the map: a title box (the largest text) and a gap."""
-    title_pt = _TITLE_FONT * _font_size(width_px)
-    return (1.25 + 2 * _BOX_PAD) * title_pt * _DPI / 72.0 + 6.0
-
-
-def _shorten(text: str, size_pt: float, width: float) -> str:
-    """``text``, cut and ended with "…" where needed so that it is at most ``width`` px wide."""
-    if text_size(text, size_pt)[0] <= width:
-        return text
-    while len(text) > 1 and text_size(text + "\u2026", size_pt)[0] > width:
-        text = text[:-1]
-    return text.rstrip() + "\u2026"
-
-
 def _rgba_to_rgb(rgba: NDArray[np.uint8]) -> NDArray[np.uint8]:
     """``(H, W, 4)`` → new contiguous ``(H, W, 3)``.
 
@@ -766,43 +610,6 @@ def _scan_points(
     ang = yaw + spec.angles()
     ends = origin + r[:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
     return origin, ends, hit
-
-
-def _map_image(
-    grid: OccupancyGrid, scale: float
-) -> tuple[NDArray[np.uint8], tuple[float, float, float, float]]:
-    """The map as an RGBA image (row 0 at the origin) and its extent ``(l, r, b, t)`` (m).
-
-    When several cells fall on one pixel, blocks of cells are pooled with priority
-    occupied > unknown > free, so that one-cell walls never vanish in a zoomed-out frame.
-    """
-    data = grid.data
-    factor = math.floor(1.0 / (scale * grid.resolution))
-    # Priority codes: 0 padding (transparent), 1 free, 2 unknown, 3 occupied.
-    prio = np.ones(data.shape, dtype=np.uint8)
-    prio[data == UNKNOWN] = 2
-    prio[data == OCCUPIED] = 3
-    prio[(data != FREE) & (data != UNKNOWN) & (data != OCCUPIED)] = 2
-    if factor >= 2:
-        h, w = prio.shape
-        hp, wp = -(-h // factor) * factor, -(-w // factor) * factor
-        padded = np.zeros((hp, wp), dtype=np.uint8)
-        padded[:h, :w] = prio
-        prio = padded.reshape(hp // factor, factor, wp // factor, factor).max(axis=(1, 3))
-        cell = grid.resolution * factor
-    else:
-        cell = grid.resolution
-    lut = np.zeros((4, 4), dtype=np.uint8)
-    lut[1, :3], lut[2, :3], lut[3, :3] = (
-        style.to_uint8(style.FREE),
-        style.to_uint8(style.UNKNOWN),
-        style.to_uint8(style.OCCUPIED),
-    )
-    lut[1:, 3] = 255
-    image = lut[prio]
-    ox, oy = grid.origin
-    extent = (ox, ox + prio.shape[1] * cell, oy, oy + prio.shape[0] * cell)
-    return image, extent
 
 
 def render_world(
