@@ -267,8 +267,10 @@ def test_video_is_readable_and_its_legend_lists_what_it_shows(tmp_path, monkeypa
     cfg = load_config(None, [*FAST, "output.video=true", "episodes=1", "task.timeout=4",
                              "output.frame_every=4"])
     _, (res,) = run_experiment(cfg, tmp_path)
-    width, height = iio.immeta(res.files["video"], extension=".mp4")["size"]
+    meta = iio.immeta(res.files["video"], extension=".mp4")
+    width, height = meta["size"]
     assert width == 800 and height % 2 == 0  # the default output.width_px, even for H.264
+    assert meta["codec"] == "h264"
     (legend,) = legends
     elements = [e for e in legend if e not in style.AGENT_STATE_NAMES]
     expected = ["robot", "collision", "trail", "plan", "goal", "lidar"]

@@ -110,7 +110,7 @@ def legend_items(
     for ov in overlays:
         if ov is None:
             continue
-        if any(p is not None and len(p) >= 2 for p in ov.paths or ()):
+        if any(p is not None and np.shape(p)[0] >= 2 for p in ov.paths or ()):
             items.append("plan")
         if _any_finite(ov.goals):
             items.append("goal")
