@@ -39,7 +39,12 @@ from arena.render.layout import (
     frame_layout,
 )
 from arena.render.legend import DPI, draw_legend, legend_entries
-from arena.render.mapview import draw_scale_bar, map_image
+from arena.render.mapview import (
+    draw_scale_bar,
+    map_image,
+    scale_bar_height_px,
+    scale_bar_length,
+)
 from arena.sensors.spec import LidarSpec
 from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 
@@ -261,12 +266,12 @@ class FrameRenderer:
                     zorder=1,
                 )
             )
-        draw_scale_bar(ax, self.extent, self.scale, self._font_size())
         font = self._font_size() * LEGEND_FONT
         box = draw_legend(ax, self.legend, font, self.width_px) if self.legend else (
             self.width_px, 0.0, self.width_px, 0.0)
         # as (col0, row0, col1, row1) frame pixels, row 0 at the top
         self.legend_box = (box[0], self.height_px - box[3], box[2], self.height_px - box[1])
+        self._draw_scale_bar()
         if self.title:
             # Top right: the top-left corner holds the time line.
             ax.text(
@@ -282,6 +287,24 @@ class FrameRenderer:
                 bbox=self._text_box(),
                 parse_math=False,
             )
+
+    def _draw_scale_bar(self) -> None:
+        """The scale bar: above the legend in its column where it fits, else bottom left.
+
+        In the legend's column it never hides the map (a start or goal in that corner).
+        """
+        font, lay = self._font_size(), self.layout
+        left, bottom, right, _ = self.extent
+        column_top = self.legend_box[1] - 4.0  # the legend box's top margin
+        length = scale_bar_length((lay.legend_px - 24.0) / self.scale)
+        if (self.legend and length is not None
+                and column_top - lay.strip_px >= scale_bar_height_px(font)):
+            corner = self.pixel_to_world([self.width_px - lay.legend_px, column_top])
+            draw_scale_bar(self._ax, (float(corner[0]), float(corner[1])), length, self.scale,
+                           font)
+        else:
+            length = scale_bar_length(0.2 * (right - left)) or 0.2 * (right - left)
+            draw_scale_bar(self._ax, (left, bottom), length, self.scale, font)
 
     def _line_top(self, k: int) -> float:
         """Axes ``y`` of the top of text line ``k`` of the strip (0: the top line)."""

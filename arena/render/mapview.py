@@ -57,26 +57,35 @@ def map_image(
     return image, extent
 
 
+def scale_bar_length(max_length_m: float) -> float | None:
+    """The longest of :data:`SCALE_STEPS` up to ``max_length_m`` (m), or ``None``."""
+    fits = [v for v in SCALE_STEPS if v <= max_length_m]
+    return fits[-1] if fits else None
+
+
+def scale_bar_height_px(font_pt: float) -> float:
+    """Pixels from the bottom of a scale bar's area to the top of its box."""
+    return 12.0 + 5.0 + 1.6 * font_pt * DPI / 72.0 + 6.0
+
+
 def draw_scale_bar(
-    ax: Axes, extent: tuple[float, float, float, float], scale: float, font_pt: float
+    ax: Axes, corner: tuple[float, float], length: float, scale: float, font_pt: float
 ) -> None:
-    """A boxed black-and-white scale bar in the bottom-left corner of the frame.
+    """A boxed black-and-white scale bar.
 
     Args:
         ax: the frame's axes (data coordinates in metres).
-        extent: the world area ``(xmin, ymin, xmax, ymax)`` (m) the frame shows.
+        corner: world point ``(x, y)`` (m) at the bottom left of the area the bar is placed in;
+            its box starts 6 px right of and above it.
+        length: the bar's length (m).
         scale: pixels per metre.
         font_pt: the label's font size (pt).
     """
     s = scale
-    left, bottom, right, _ = extent
-    view_w = right - left
-    fits = [v for v in SCALE_STEPS if v <= 0.2 * view_w]
-    length = fits[-1] if fits else view_w * 0.2
     pad, bar_h = 12.0 / s, 5.0 / s
     fontsize = font_pt
     text_h = 1.6 * fontsize * DPI / 72.0 / s
-    x0, y0 = left + pad, bottom + pad
+    x0, y0 = corner[0] + pad, corner[1] + pad
     ax.add_patch(
         Rectangle(
             (x0 - 0.5 * pad, y0 - 0.5 * pad),

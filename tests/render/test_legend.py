@@ -184,3 +184,19 @@ def test_scans_robots_and_people_never_cover_the_legend():
     busy = r.render(_state(step=1, xy=(3.9, 0.5), scan=30.0, people=(1,)))
     assert np.array_equal(busy[r0:r1, c0:c1], plain[r0:r1, c0:c1])
     assert not np.array_equal(busy[:, : c0 - 1], plain[:, : c0 - 1])
+
+
+def test_the_scale_bar_sits_above_the_legend_where_it_fits():
+    renderer_of = {
+        size: FrameRenderer(StaticWorld.build(OccupancyGrid.empty(*size, 0.1)), width_px=800,
+                            legend=["robot", "goal", "walking"])
+        for size in [(20, 20), (40, 3)]
+    }
+    for size, r in renderer_of.items():
+        label = next(t for t in r._ax.texts if t.get_text().endswith(" m"))
+        ext = label.get_window_extent(r._canvas.get_renderer())
+        right_of_map = r.world_to_pixel([[float(size[0]), 0.0]])[0, 0]
+        if size == (20, 20):  # room above the legend: in its column, off the map
+            assert ext.x0 >= right_of_map and r.height_px - ext.y0 <= r.legend_box[1]
+        else:  # a wide map's frame is no taller than the legend: the bottom-left corner
+            assert ext.x1 < r.legend_box[0] and r.height_px - ext.y0 > r.legend_box[1]
