@@ -114,6 +114,13 @@ class FrameRenderer:
             :data:`arena.render.layout.KNOWN_MARGIN_M`): a building in the middle of a large
             unknown map fills the frame instead of a small part of it.
 
+    Attributes:
+        layout: the frame's :class:`~arena.render.layout.FrameLayout` (size, scale, strip).
+        legend: the legend's entries, in legend order.
+        legend_box: the legend's box ``(col0, row0, col1, row1)`` in frame pixels, row 0 at
+            the top (empty at the right edge without a legend).
+        title: the title as drawn (maybe shortened).
+
     Raises:
         ConfigError: ``width_px`` out of range or too narrow for the legend, ``max_height_px``
             below 16, ``margin_m`` negative, or an unknown legend entry.
