@@ -22,7 +22,7 @@ $(TEST_STAMP): pyproject.toml | $(PY)
 	touch $@ $(STAMP)
 
 ## run: create .venv, install Arena and run the main job: the packaged quick benchmark
-## (4 planners x 8 episodes in 3 worlds with people + a corridor scenario) and its report
+## (4 planners x 31 episodes: 10 in each of 3 worlds with people + a corridor scenario) and its report
 RUN_DIR ?= runs/quick_$(shell date +%Y%m%d-%H%M%S)
 run: $(STAMP)
 	$(VENV)/bin/arena bench quick --contest quick --workers 2 -o $(RUN_DIR) --report $(ARGS)

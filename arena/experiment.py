@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 import yaml
+from numpy.typing import NDArray
 
 import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.schema import ExperimentConfig
@@ -312,12 +313,16 @@ def run_episode(
     recorder.record(state)
     rec.record(state)
     states = [state] if video else []
+    # per recorded state the plan and goal it was driven by, so a video shows each at its time
+    views: list[tuple[NDArray[np.float64], Pose2D]] = []
     outcome, error = Outcome.TIMEOUT, ""
     collisions, touching = 0, False
     jumps: list[int] = []  # recorder rows reached by a teleport (not driven)
     wall_start = time.perf_counter()
     try:
         stack.reset(planning_grid(episode), spawn.start, goal)
+        if video:
+            views.append((stack.path, goal))
         while True:
             update = runtime.update(state.time, state.robots.poses, state.agents.positions)
             if 0 in update.reached:
@@ -385,6 +390,7 @@ def run_episode(
             rec.record(state)
             if video:
                 states.append(state)
+                views.append((stack.path, goal))
             hit = bool(state.collisions.any[0])
             collisions += hit and not touching  # count contact events, not contact steps
             touching = hit
@@ -459,7 +465,7 @@ def run_episode(
         result.files["record"] = str(save_record(record, out_dir / "episode.parquet"))
         if video and states:
             result.files.update(
-                _write_video(cfg, backend, states, stack.path, goal, out_dir, outcome, episode)
+                _write_video(cfg, backend, states, views, out_dir, outcome, episode)
             )
         result.wall_time = time.perf_counter() - t0
         (out_dir / "episode.json").write_text(json.dumps(result.summary(), indent=2))
@@ -468,11 +474,21 @@ def run_episode(
 
 
 def _write_video(
-    cfg, backend, states, path, goal, out_dir: Path, outcome: Outcome, episode: Episode
+    cfg, backend, states, views, out_dir: Path, outcome: Outcome, episode: Episode
 ) -> dict[str, str]:
+    """The episode's video and its last frame; ``views[k]`` is state ``k``'s (plan, goal)."""
     # Imported here: rendering is optional and the only user of matplotlib.
-    from arena.render import FrameRenderer, Overlay, VideoWriter, save_png
+    from arena.render import FrameRenderer, Overlay, VideoWriter, legend_items, save_png
 
+    last = len(states) - 1
+    drawn = [k for k in range(len(states)) if k % cfg.output.frame_every == 0 or k == last]
+    overlays = []
+    for k in drawn:
+        # no plan yet where planning failed at the start: the goal alone
+        path, goal = views[k] if k < len(views) else (None, episode.robots[0].goal)
+        text = f"t = {states[k].time:5.1f} s   step {states[k].step}"
+        overlays.append(Overlay(paths=[path], goals=goal.as_array()[None, :],
+                                text=text + (f"   {outcome.value}" if k == last else "")))
     robot_specs = [spawn.model.laser for spawn in episode.robots]
     renderer = FrameRenderer(
         backend.world,
@@ -482,21 +498,18 @@ def _write_video(
             t for t in (run_name(cfg), episode.label, states[0].robots.models[0], cfg.crowd["type"])
             if t
         ),
-        legend=len(states[0].agents) > 0,
+        # a key to exactly what the video shows (its social states, a collision if one happens)
+        legend=legend_items(
+            [states[k] for k in drawn], overlays,
+            lidar=any(spec is not None for spec in robot_specs), trails=True,
+        ),
     )
     video_path = out_dir / f"video.{cfg.output.video_format}"
-    goals = goal.as_array()[None, :]
     fps = 1.0 / cfg.sim.dt / cfg.output.frame_every
     frame = None
     with VideoWriter(video_path, fps=fps) as writer:
-        for k, s in enumerate(states):
-            last = k == len(states) - 1
-            if k % cfg.output.frame_every and not last:
-                continue
-            text = f"t = {s.time:5.1f} s   step {s.step}"
-            if last:
-                text += f"   {outcome.value}"
-            frame = renderer.render(s, Overlay(paths=[path], goals=goals, text=text))
+        for k, ov in zip(drawn, overlays, strict=True):
+            frame = renderer.render(states[k], ov)
             writer.append(frame)
     files = {"video": str(video_path)}
     if frame is not None:

@@ -223,11 +223,11 @@ def test_tasks_list_and_preview(monkeypatch, capsys):
                            "--contest", "basic")
     assert code == 0, out
     assert "corridor_scenario" in out and "canteen" in out
-    assert "total: 8 episodes in 4 stages" in out
-    assert "1 contestants x 8 episodes" in out
+    assert "total: 31 episodes in 4 stages" in out
+    assert "1 contestants x 31 episodes" in out
     code, out2, _ = run_cli(monkeypatch, capsys, "tasks", "preview", "quick", "--seed", "3",
-                            "--scale", "2")
-    assert code == 0 and "total: 16 episodes" in out2
+                            "--scale", "0.1")
+    assert code == 0 and "total: 3 episodes" in out2
 
 
 def test_tasks_preview_errors_are_one_line(monkeypatch, capsys, tmp_path):

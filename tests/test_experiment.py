@@ -244,3 +244,42 @@ def test_output_folder_that_cannot_be_made_is_a_one_line_error(where, tmp_path):
         target.write_text("mine")
     with pytest.raises(ArenaError, match=r"output folder \(output\.dir, -o\)"):
         run_experiment(load_config(None, FAST), Path(target))
+
+
+def test_video_is_readable_and_its_legend_lists_what_it_shows(tmp_path, monkeypatch):
+    import imageio.v3 as iio
+
+    import arena.render as render
+    from arena.render import style
+
+    legends, plans = [], []
+
+    class Recording(render.FrameRenderer):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            legends.append(self.legend)
+
+        def render(self, state, overlay=None):
+            plans.append((state.robots.poses[0, :2].copy(), overlay.paths[0]))
+            return super().render(state, overlay)
+
+    monkeypatch.setattr(render, "FrameRenderer", Recording)
+    cfg = load_config(None, [*FAST, "output.video=true", "episodes=1", "task.timeout=4",
+                             "output.frame_every=4"])
+    _, (res,) = run_experiment(cfg, tmp_path)
+    meta = iio.immeta(res.files["video"], extension=".mp4")
+    width, height = meta["size"]
+    assert width == 800 and height % 2 == 0  # the default output.width_px, even for H.264
+    assert meta["codec"] == "h264"
+    (legend,) = legends
+    elements = [e for e in legend if e not in style.AGENT_STATE_NAMES]
+    expected = ["robot", "collision", "trail", "plan", "goal", "lidar"]
+    if res.collisions == 0:
+        expected.remove("collision")
+    assert elements == expected
+    assert 1 <= len(legend) - len(elements) <= len(style.AGENT_STATE_NAMES)  # people's states
+    # each frame shows the plan of its time: the first one starts where the robot starts
+    (start, first), (end, final) = plans[0], plans[-1]
+    assert np.hypot(*(first[0] - start)) < 0.3
+    assert np.hypot(*(end - start)) > 1.0  # the robot drove off
+    assert np.hypot(*(final[0] - start)) > 1.0  # and replanned: the last frame's plan is newer

@@ -24,7 +24,7 @@ Default suite (:func:`test_readme_commands_parse_and_validate`):
 Slow suite (:func:`test_readme_runs_every_command_and_snippet`, ``pytest -m slow``): every
 command and snippet runs in full, with these reductions appended to keep it minutes long:
 ``arena run`` gets ``-n 1`` (one episode); ``arena bench paper`` gets ``--scale 0.1`` (13 of
-160 episodes, every stage kept; ``quick`` runs in full); ``arena train`` gets ``--steps 256
+160 episodes, every stage kept; ``quick``'s 31 run in full); ``arena train`` gets ``--steps 256
 --envs 1``; ``--interactive`` runs get ``reset`` on stdin (the episode
 ends at once instead of running for a minute of wall time).
 """
@@ -63,7 +63,7 @@ REDUCTIONS: dict[str, list[str]] = {
 
 BENCH_SCALES = {"paper": "0.1"}
 """``--scale`` the slow test gives ``arena bench SUITE``: the paper suite's 160 episodes become
-13, every stage kept; ``quick`` (8 episodes) runs in full."""
+13, every stage kept; ``quick`` (31 episodes) runs in full."""
 
 
 def _reduced(args: list[str]) -> list[str]:

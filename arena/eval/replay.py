@@ -64,7 +64,7 @@ def pick_episodes(table: Any, count: int = 1) -> list[tuple[str, int]]:
 
 def render_episode_video(
     record_path: str | Path, out_dir: str | Path, *, caption: str | None = None,
-    width_px: int = 480, frame_every: int = 2,
+    width_px: int | None = None, frame_every: int = 2,
 ) -> EpisodeVideo:
     """Simulate a recorded episode again with the video on.
 
@@ -72,7 +72,8 @@ def render_episode_video(
         record_path: the episode's ``.parquet`` record (its meta holds the resolved config).
         out_dir: folder for ``video.mp4`` (and ``final.png``).
         caption: the video's caption (default: stage or map, episode and outcome).
-        width_px: frame width.
+        width_px: frame width (pixels); ``None``: the recorded config's ``output.width_px``
+            (800 unless the run set it), readable in the report.
         frame_every: render every N-th step (N = 2 halves the file at 10 Hz simulation).
 
     Returns:
@@ -87,7 +88,8 @@ def render_episode_video(
 
     record = load_record(record_path)
     data = dict(record.meta.config)
-    data["output"] = {**data.get("output", {}), "width_px": width_px,
+    size = {} if width_px is None else {"width_px": width_px}
+    data["output"] = {**data.get("output", {}), **size,
                       "frame_every": frame_every, "video_format": "mp4"}
     data["evaluation"] = {**data.get("evaluation", {}), "counterfactual": False}
     cfg = ExperimentConfig.model_validate(data)
@@ -107,7 +109,7 @@ def render_episode_video(
 
 def episode_videos(
     run_dir: str | Path, table: Any, dest: str | Path, *, count: int = 1, workers: int = 1,
-    width_px: int = 480,
+    width_px: int | None = None,
 ) -> list[EpisodeVideo]:
     """Videos of the :func:`pick_episodes` episodes for every contestant.
 
@@ -117,7 +119,7 @@ def episode_videos(
         dest: folder for the videos (``<contestant>/<stage>_<episode>/video.mp4``).
         count: number of episodes (each rendered for every contestant).
         workers: processes rendering at once.
-        width_px: frame width.
+        width_px: frame width (pixels); ``None``: each record's ``output.width_px``.
 
     Returns:
         The videos, episodes in rank order and contestants in table order.

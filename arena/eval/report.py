@@ -62,7 +62,7 @@ tr.o-collision td,tr.o-timeout td,tr.o-error td{background:#fff4f0}
 details{margin:0.3em 0}summary{cursor:pointer;font-weight:bold;font-size:1.05em;
 padding:0.3em 0}
 .vids{display:flex;flex-wrap:wrap;gap:12px}.vids figure{margin:0;width:100%;max-width:960px}
-video{width:100%;min-width:min(720px,100%);background:#000}
+video{width:100%;max-width:960px;min-width:min(720px,100%);background:#000}
 figcaption{font-size:0.85em;color:#555}
 """
 

@@ -9,14 +9,17 @@ Example:
     ...         video.append(renderer.render(state, Overlay(text="running")))
 """
 
-from arena.render.frames import FrameRenderer, Overlay, render_world
+from arena.render.frames import DEFAULT_WIDTH_PX, FrameRenderer, Overlay, render_world
+from arena.render.legend import legend_items
 from arena.render.video import RenderError, VideoWriter, render_episode, save_png
 
 __all__ = [
+    "DEFAULT_WIDTH_PX",
     "FrameRenderer",
     "Overlay",
     "RenderError",
     "VideoWriter",
+    "legend_items",
     "render_episode",
     "render_world",
     "save_png",

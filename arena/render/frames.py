@@ -16,7 +16,6 @@ open figure registry is involved.
 
 from __future__ import annotations
 
-import math
 import sys
 from collections import deque
 from collections.abc import Sequence
@@ -26,28 +25,41 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection, PolyCollection
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
+from matplotlib.transforms import Bbox
 from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import ConfigError
 from arena.core.geometry import regular_polygon, transform_points
-from arena.maps.grid import FREE, OCCUPIED, UNKNOWN, OccupancyGrid
 from arena.render import style
+from arena.render.layout import (
+    BOX_PAD,
+    LEGEND_FONT,
+    TITLE_FONT,
+    font_size,
+    frame_layout,
+)
+from arena.render.legend import DPI, draw_legend, legend_entries
+from arena.render.mapview import (
+    draw_scale_bar,
+    map_image,
+    scale_bar_height_px,
+    scale_bar_length,
+)
 from arena.sensors.spec import LidarSpec
 from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 
 FloatArray = NDArray[np.float64]
 
-_DPI = 100.0
+_DPI = DPI
 # Tiny extra canvas size so that ``int(inches · dpi)`` never truncates to one pixel too few.
 _PAD_PX = 1e-3
 _ROBOT_CIRCLE_SIDES = 40
 _AGENT_CIRCLE_SIDES = 24
-_SCALE_STEPS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0)
 
 
-MAX_WIDTH_PX = 8000
-"""Widest frame drawn (pixels): an 8K image; wider ones take gigabytes for nothing."""
+DEFAULT_WIDTH_PX = 800
+"""Frame width (pixels) of videos and stills unless asked otherwise: text and the legend stay
+readable in a report or on a slide."""
 
 
 @dataclass(frozen=True)
@@ -82,18 +94,36 @@ class FrameRenderer:
         world: the map and placed obstacles; drawn once.
         lidar_specs: per robot index the lidar that produced ``RobotStates.scans[i]``, or
             ``None`` for robots whose scans should not be drawn. Missing entries count as ``None``.
-        width_px: frame width in pixels; the height follows from the view's aspect ratio.
+        width_px: frame width in pixels; the height follows from the view's aspect ratio, up to
+            ``max_height_px``.
         show_lidar: draw lidar hit points and the scanned area as a faint fan.
         show_trails: draw each robot's past positions (recorded across :meth:`render` calls, or
             taken from :attr:`Overlay.trails`).
-        title: text shown at the top right of every frame.
+        title: text shown at the top right of every frame (shortened with "…" where it would
+            not fit; on a line of its own under the time line where both do not fit on one).
         margin_m: extra space around the map and obstacles (m).
         trail_length: how many past positions a recorded trail keeps.
-        legend: draw the pedestrian social-state colour legend (bottom right, in its own
-            column right of the map; the frame is then at least as tall as the legend).
+        legend: the legend's entries (names from :data:`arena.render.legend.ELEMENTS` and
+            social-state names, see :func:`arena.render.legend.legend_items`), ``True`` for all
+            of them, ``False`` or empty for none. It is drawn bottom right in a column of its
+            own right of the map, so it never hides the map; the frame is at least as tall as it.
+        max_height_px: the tallest frame (pixels, default ``width_px``): a map taller than that
+            is scaled down to fit and centred, so a long corridor standing upright does not
+            give a frame thousands of pixels tall.
+        crop_unknown: show only the mapped part of the map (cells not unknown, plus
+            :data:`arena.render.layout.KNOWN_MARGIN_M`): a building in the middle of a large
+            unknown map fills the frame instead of a small part of it.
+
+    Attributes:
+        layout: the frame's :class:`~arena.render.layout.FrameLayout` (size, scale, strip).
+        legend: the legend's entries, in legend order.
+        legend_box: the legend's box ``(col0, row0, col1, row1)`` in frame pixels, row 0 at
+            the top (empty at the right edge without a legend).
+        title: the title as drawn (maybe shortened).
 
     Raises:
-        ConfigError: ``width_px`` is too small or ``margin_m`` negative.
+        ConfigError: ``width_px`` out of range or too narrow for the legend, ``max_height_px``
+            below 16, ``margin_m`` negative, or an unknown legend entry.
     """
 
     def __init__(
@@ -101,47 +131,30 @@ class FrameRenderer:
         world: StaticWorld,
         *,
         lidar_specs: Sequence[LidarSpec | None] = (),
-        width_px: int = 800,
+        width_px: int = DEFAULT_WIDTH_PX,
         show_lidar: bool = True,
         show_trails: bool = True,
         title: str = "",
         margin_m: float = 0.0,
         trail_length: int = 600,
-        legend: bool = False,
+        legend: bool | Sequence[str] = False,
+        max_height_px: int | None = None,
+        crop_unknown: bool = True,
     ) -> None:
-        if not 16 <= width_px <= MAX_WIDTH_PX:
-            raise ConfigError(
-                f"width_px must lie in [16, {MAX_WIDTH_PX}] pixels, got {width_px}"
-            )
-        if margin_m < 0:
-            raise ConfigError(f"margin_m must be >= 0 m, got {margin_m}")
         self.world = world
-        self.legend = legend
+        self.legend: tuple[str, ...] = legend_entries(legend)
         self.lidar_specs: tuple[LidarSpec | None, ...] = tuple(lidar_specs)
         self.show_lidar = show_lidar
         self.show_trails = show_trails
-        self.title = title
         self._trail: deque[FloatArray] = deque(maxlen=max(int(trail_length), 1))
         self._trail_key: tuple[tuple[str, ...], int] | None = None
-
-        # -- view: map ∪ obstacles, padded; scale s (px/m) is the same on both axes.
-        xmin, ymin, xmax, ymax = world.grid.bounds
-        for ob in world.obstacles:
-            poly = ob.polygon
-            xmin, ymin = min(xmin, float(poly[:, 0].min())), min(ymin, float(poly[:, 1].min()))
-            xmax, ymax = max(xmax, float(poly[:, 0].max())), max(ymax, float(poly[:, 1].max()))
-        xmin, ymin, xmax, ymax = xmin - margin_m, ymin - margin_m, xmax + margin_m, ymax + margin_m
-        # The legend gets its own column right of the map (it must never hide the map, e.g. the
-        # goal at the end of a long corridor), and the frame is tall enough for it and the title.
-        legend_w, legend_h = _legend_extent(width_px) if legend else (0.0, 0.0)
-        self.scale = (float(width_px) - legend_w) / (xmax - xmin)
-        if title or legend:  # a strip above the map for the title and the time line
-            ymax += _title_height(width_px) / self.scale
-        height_px = max(2, math.ceil((ymax - ymin) * self.scale - 1e-6))
-        if legend:
-            height_px = max(height_px, math.ceil(legend_h + _title_height(width_px)))
-        height_px += height_px % 2
-        self.width_px, self.height_px = int(width_px), int(height_px)
+        self.layout = frame_layout(
+            world, width_px=width_px, max_height_px=max_height_px, margin_m=margin_m,
+            crop_unknown=crop_unknown, title=title, legend=self.legend,
+        )
+        self.width_px, self.height_px = self.layout.width_px, self.layout.height_px
+        self.scale = self.layout.scale
+        self.title = self.layout.title
 
         self._fig = Figure(
             figsize=((self.width_px + _PAD_PX) / _DPI, (self.height_px + _PAD_PX) / _DPI), dpi=_DPI
@@ -151,12 +164,11 @@ class FrameRenderer:
         ax = self._fig.add_axes((0.0, 0.0, 1.0, 1.0))
         ax.set_axis_off()
         ax.set_facecolor(style.BACKGROUND)
-        # Fix the limits from the real canvas size so both axes get exactly ``scale`` px/m. The
-        # extra height from rounding up is split evenly above and below; the sub-pixel pad lies
-        # past the right and bottom edges, which the pixel buffer cuts off.
+        # Fix the limits from the real canvas size so both axes get exactly ``scale`` px/m; the
+        # sub-pixel pad lies past the right and top edges, which the pixel buffer cuts off.
         bw, bh = self._fig.bbox.width, self._fig.bbox.height
-        ytop = 0.5 * (ymin + ymax) + 0.5 * self.height_px / self.scale
-        self._xlim = (xmin, xmin + bw / self.scale)
+        x0, ytop = self.layout.left_m, self.layout.top_m
+        self._xlim = (x0, x0 + bw / self.scale)
         self._ylim = (ytop - bh / self.scale, ytop)
         ax.set_xlim(*self._xlim)
         ax.set_ylim(*self._ylim)
@@ -247,7 +259,7 @@ class FrameRenderer:
 
     def _draw_static(self) -> None:
         ax, grid = self._ax, self.world.grid
-        image, extent = _map_image(grid, self.scale)
+        image, extent = map_image(grid, self.scale)
         ax.imshow(
             image, origin="lower", extent=extent, interpolation="nearest", resample=False, zorder=0
         )
@@ -261,141 +273,60 @@ class FrameRenderer:
                     zorder=1,
                 )
             )
+        font = self._font_size() * LEGEND_FONT
+        box = draw_legend(ax, self.legend, font, self.width_px) if self.legend else (
+            self.width_px, 0.0, self.width_px, 0.0)
+        # as (col0, row0, col1, row1) frame pixels, row 0 at the top
+        self.legend_box = (box[0], self.height_px - box[3], box[2], self.height_px - box[1])
         self._draw_scale_bar()
-        if self.legend:
-            self._draw_legend()
-        fontsize = self._font_size()
         if self.title:
             # Top right: the top-left corner holds the time line.
             ax.text(
                 1.0 - 8.0 / self.width_px,
-                1.0 - 8.0 / self.height_px,
+                self._line_top(self.layout.title_line),
                 self.title,
                 transform=ax.transAxes,
                 ha="right",
                 va="top",
-                fontsize=fontsize * 1.15,
+                fontsize=self._font_size() * TITLE_FONT,
                 color=style.TEXT,
                 zorder=20,
                 bbox=self._text_box(),
+                parse_math=False,
             )
 
-    def _draw_legend(self) -> None:
-        """Social-state colours, bottom right, in one boxed column of coloured dots.
+    def _draw_scale_bar(self) -> None:
+        """The scale bar: above the legend in its column where it fits, else bottom left.
 
-        Drawn under robots, goals and people (above the map) so it never hides them.
+        In the legend's column it never hides the map (a start or goal in that corner).
         """
-        ax = self._ax
-        fs = self._font_size() * 0.8
-        line = fs * 1.45 / 72.0 * _DPI  # pixels per legend row
-        names = style.AGENT_STATE_NAMES
-        x = 1.0 - 8.0 / self.width_px
-        for k, name in enumerate(reversed(names)):
-            code = len(names) - 1 - k
-            y = (8.0 + line * (k + 0.5)) / self.height_px
-            ax.text(
-                x,
-                y,
-                f"{name} \u25cf",
-                transform=ax.transAxes,
-                ha="right",
-                va="center",
-                fontsize=fs,
-                color=style.TEXT,
-                zorder=1.6,
-            )
-            ax.text(
-                x,
-                y,
-                "\u25cf",
-                transform=ax.transAxes,
-                ha="right",
-                va="center",
-                fontsize=fs,
-                color=style.AGENT_STATE_COLORS[code],
-                zorder=1.7,
-            )
-        top = (8.0 + line * len(names)) / self.height_px
-        left = 1.0 - (8.0 + fs * 7.5 / 72.0 * _DPI) / self.width_px
-        ax.add_patch(
-            Rectangle(
-                (left, 4.0 / self.height_px),
-                1.0 - left - 4.0 / self.width_px,
-                top - 2.0 / self.height_px,
-                transform=ax.transAxes,
-                facecolor=style.TEXT_BOX,
-                alpha=style.TEXT_BOX_ALPHA,
-                edgecolor="none",
-                zorder=1.5,
-            )
-        )
+        font, lay = self._font_size(), self.layout
+        left, bottom, right, _ = self.extent
+        column_top = self.legend_box[1] - 4.0  # the legend box's top margin
+        length = scale_bar_length((lay.legend_px - 24.0) / self.scale)
+        if (self.legend and length is not None
+                and column_top - lay.strip_px >= scale_bar_height_px(font)):
+            corner = self.pixel_to_world([self.width_px - lay.legend_px, column_top])
+            draw_scale_bar(self._ax, (float(corner[0]), float(corner[1])), length, self.scale,
+                           font)
+        else:
+            length = scale_bar_length(0.2 * (right - left)) or 0.2 * (right - left)
+            draw_scale_bar(self._ax, (left, bottom), length, self.scale, font)
+
+    def _line_top(self, k: int) -> float:
+        """Axes ``y`` of the top of text line ``k`` of the strip (0: the top line)."""
+        return 1.0 - self.layout.line_top_px(k) / self.height_px
 
     def _font_size(self) -> float:
-        return _font_size(self.width_px)
+        return font_size(self.width_px)
 
     def _text_box(self) -> dict[str, object]:
         return {
-            "boxstyle": "round,pad=0.3",
+            "boxstyle": f"round,pad={BOX_PAD}",
             "facecolor": style.TEXT_BOX,
             "alpha": style.TEXT_BOX_ALPHA,
             "edgecolor": "none",
         }
-
-    def _draw_scale_bar(self) -> None:
-        ax, s = self._ax, self.scale
-        left, bottom, right, _ = self.extent
-        view_w = right - left
-        fits = [v for v in _SCALE_STEPS if v <= 0.2 * view_w]
-        length = fits[-1] if fits else view_w * 0.2
-        pad, bar_h = 12.0 / s, 5.0 / s
-        fontsize = self._font_size()
-        text_h = 1.6 * fontsize * _DPI / 72.0 / s
-        x0, y0 = left + pad, bottom + pad
-        ax.add_patch(
-            Rectangle(
-                (x0 - 0.5 * pad, y0 - 0.5 * pad),
-                length + pad,
-                bar_h + text_h + pad,
-                facecolor=style.TEXT_BOX,
-                alpha=style.TEXT_BOX_ALPHA,
-                edgecolor="none",
-                zorder=20,
-            )
-        )
-        # Half black, half white: the bar reads on both light and dark backgrounds.
-        ax.add_patch(
-            Rectangle(
-                (x0, y0),
-                length,
-                bar_h,
-                facecolor=style.TEXT,
-                edgecolor=style.TEXT,
-                linewidth=self._px(1.0),
-                zorder=21,
-            )
-        )
-        ax.add_patch(
-            Rectangle(
-                (x0 + 0.5 * length, y0),
-                0.5 * length,
-                bar_h,
-                facecolor="white",
-                edgecolor=style.TEXT,
-                linewidth=self._px(1.0),
-                zorder=22,
-            )
-        )
-        label = f"{length:g} m"
-        ax.text(
-            x0 + 0.5 * length,
-            y0 + bar_h + 2.0 / s,
-            label,
-            ha="center",
-            va="bottom",
-            fontsize=fontsize,
-            color=style.TEXT,
-            zorder=22,
-        )
 
     # -- dynamic artists ------------------------------------------------------------------------
     def _make_dynamic(self) -> None:
@@ -450,7 +381,7 @@ class FrameRenderer:
         )
         self._hud = ax.text(
             8.0 / self.width_px,
-            1.0 - 8.0 / self.height_px,
+            self._line_top(0),
             "",
             transform=ax.transAxes,
             ha="left",
@@ -460,6 +391,7 @@ class FrameRenderer:
             color=style.TEXT,
             zorder=20,
             bbox=self._text_box(),
+            parse_math=False,
         )
         for coll in (
             self._fans,
@@ -489,9 +421,16 @@ class FrameRenderer:
             ),
             key=lambda a: a.get_zorder(),
         )
+        # Robots, people and scans stay in the map area: never over the legend or the strip.
+        map_area = Bbox.from_extents(
+            0.0, 0.0, self.width_px - self.layout.legend_px, self.height_px - self.layout.strip_px
+        )
         for artist in self._dynamic:
             # Animated artists are left out of canvas.draw(): the background stays static.
             artist.set_animated(True)
+            if artist is not self._hud:
+                artist.set_clip_box(map_area)
+                artist.set_clip_on(True)
         self._agent_circle = regular_polygon(1.0, _AGENT_CIRCLE_SIDES)
         # Goal arrow in pixels (shaft, head), converted to metres once: it is a marker, not a
         # physical object, so it keeps its size on screen whatever the map size.
@@ -668,23 +607,6 @@ class FrameRenderer:
         self._robot_heading.set_segments(heads)
 
 
-def _font_size(width_px: float) -> float:
-    """Font size (pt): readable at 400 px wide, not huge at 1600 px."""
-    return float(np.clip(width_px / 75.0, 7.0, 16.0))
-
-
-def _legend_extent(width_px: float) -> tuple[float, float]:
-    """``(width, height)`` px of the social-state legend box plus its 8 px margins."""
-    fs = _font_size(width_px) * 0.8
-    line = fs * 1.45 / 72.0 * _DPI
-    return 16.0 + fs * 7.5 / 72.0 * _DPI, 16.0 + line * len(style.AGENT_STATE_NAMES)
-
-
-def _title_height(width_px: float) -> float:
-    """Pixels taken by the title line at the top (with its box and margin)."""
-    return 16.0 + _font_size(width_px) * 1.45 / 72.0 * _DPI
-
-
 def _rgba_to_rgb(rgba: NDArray[np.uint8]) -> NDArray[np.uint8]:
     """``(H, W, 4)`` → new contiguous ``(H, W, 3)``.
 
@@ -720,44 +642,9 @@ def _scan_points(
     return origin, ends, hit
 
 
-def _map_image(
-    grid: OccupancyGrid, scale: float
-) -> tuple[NDArray[np.uint8], tuple[float, float, float, float]]:
-    """The map as an RGBA image (row 0 at the origin) and its extent ``(l, r, b, t)`` (m).
-
-    When several cells fall on one pixel, blocks of cells are pooled with priority
-    occupied > unknown > free, so that one-cell walls never vanish in a zoomed-out frame.
-    """
-    data = grid.data
-    factor = math.floor(1.0 / (scale * grid.resolution))
-    # Priority codes: 0 padding (transparent), 1 free, 2 unknown, 3 occupied.
-    prio = np.ones(data.shape, dtype=np.uint8)
-    prio[data == UNKNOWN] = 2
-    prio[data == OCCUPIED] = 3
-    prio[(data != FREE) & (data != UNKNOWN) & (data != OCCUPIED)] = 2
-    if factor >= 2:
-        h, w = prio.shape
-        hp, wp = -(-h // factor) * factor, -(-w // factor) * factor
-        padded = np.zeros((hp, wp), dtype=np.uint8)
-        padded[:h, :w] = prio
-        prio = padded.reshape(hp // factor, factor, wp // factor, factor).max(axis=(1, 3))
-        cell = grid.resolution * factor
-    else:
-        cell = grid.resolution
-    lut = np.zeros((4, 4), dtype=np.uint8)
-    lut[1, :3], lut[2, :3], lut[3, :3] = (
-        style.to_uint8(style.FREE),
-        style.to_uint8(style.UNKNOWN),
-        style.to_uint8(style.OCCUPIED),
-    )
-    lut[1:, 3] = 255
-    image = lut[prio]
-    ox, oy = grid.origin
-    extent = (ox, ox + prio.shape[1] * cell, oy, oy + prio.shape[0] * cell)
-    return image, extent
-
-
-def render_world(world: StaticWorld, *, width_px: int = 800, title: str = "") -> NDArray[np.uint8]:
+def render_world(
+    world: StaticWorld, *, width_px: int = DEFAULT_WIDTH_PX, title: str = ""
+) -> NDArray[np.uint8]:
     """A top-down picture of a world with no robots or people (map previews, galleries)."""
     robots = RobotStates(
         (), (), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), (), ()

@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import ArenaError, ConfigError
+from arena.render.frames import DEFAULT_WIDTH_PX
 from arena.sensors.spec import LidarSpec
 from arena.sim.state import SimState, StaticWorld
 
@@ -198,10 +199,11 @@ def render_episode(
     every: int = 1,
     overlays: Sequence[Any] | Callable[[int, SimState], Any] | None = None,
     lidar_specs: Sequence[LidarSpec | None] = (),
-    width_px: int = 800,
+    width_px: int = DEFAULT_WIDTH_PX,
     title: str = "",
     show_lidar: bool = True,
     show_trails: bool = True,
+    legend: bool = True,
 ) -> Path:
     """Render a recorded episode to an MP4 or GIF.
 
@@ -221,6 +223,8 @@ def render_episode(
         title: text at the top of every frame.
         show_lidar: draw lidar hits and rays.
         show_trails: draw robot trails.
+        legend: draw a legend of exactly the elements the video shows (see
+            :func:`arena.render.legend.legend_items`).
 
     Returns:
         The written path.
@@ -232,6 +236,7 @@ def render_episode(
     from dataclasses import replace
 
     from arena.render.frames import FrameRenderer, Overlay
+    from arena.render.legend import legend_items
 
     if every < 1:
         raise ConfigError(f"every must be >= 1, got {every}")
@@ -242,9 +247,19 @@ def render_episode(
     writer = VideoWriter(path, fps=fps)
     if not states:
         raise RenderError(f"no states to render into {writer.path}")
+    drawn = [k for k in range(len(states)) if k % every == 0 or k == len(states) - 1]
+    # Asked once per drawn state, before drawing: the legend must know them all.
+    if callable(overlays):
+        given = {k: overlays(k, states[k]) for k in drawn}
+    else:
+        given = {k: overlays[k] if overlays is not None else None for k in drawn}
+    items = legend_items(
+        [states[k] for k in drawn], given.values(),
+        lidar=show_lidar and any(spec is not None for spec in lidar_specs), trails=show_trails,
+    ) if legend else ()
     renderer = FrameRenderer(
         world, lidar_specs=lidar_specs, width_px=width_px, title=title,
-        show_lidar=show_lidar, show_trails=show_trails,
+        show_lidar=show_lidar, show_trails=show_trails, legend=items,
     )
     history: list[NDArray[np.float64]] = []
     with writer:
@@ -253,13 +268,9 @@ def render_episode(
             if k > 0 and (state.step <= states[k - 1].step or xy.shape != history[-1].shape):
                 history = []  # a new episode starts inside the sequence
             history.append(xy)
-            if k % every and k != len(states) - 1:
+            if k not in given:
                 continue
-            if callable(overlays):
-                ov = overlays(k, state)
-            else:
-                ov = overlays[k] if overlays is not None else None
-            ov = ov if ov is not None else Overlay()
+            ov = given[k] if given[k] is not None else Overlay()
             if show_trails and ov.trails is None:
                 hist = np.stack(history)  # (k, r, 2)
                 ov = replace(ov, trails=[hist[:, i] for i in range(hist.shape[1])])

@@ -29,7 +29,7 @@ ray = pytest.importorskip("ray")
 
 CONTEST = "contestants:\n  - {name: pp, local_planner: pure_pursuit}\n"
 #: the packaged quick suite at this scale: a few episodes (one per stage but the scenario).
-SCALE = 0.5
+SCALE = 0.1
 VOLATILE = ("wall_time", "record")
 
 

@@ -258,6 +258,19 @@ def test_margin_and_obstacles_outside_map_extend_the_view() -> None:
     assert r.height_px % 2 == 0
 
 
+def test_unknown_space_around_a_building_is_cropped() -> None:
+    data = np.full((400, 400), -1, dtype=np.int8)  # 40 m x 40 m of unknown space ...
+    data[100:160, 150:250] = 0  # ... around a 10 m x 6 m mapped block at x 15..25, y 10..16
+    world = StaticWorld.build(OccupancyGrid(data, 0.1))
+    r = FrameRenderer(world, width_px=800)
+    xmin, ymin, xmax, ymax = r.extent
+    assert (xmin, xmax) == (pytest.approx(14.0), pytest.approx(26.0))  # 1 m of margin
+    assert ymin <= 9.0 and ymax >= 17.0 and ymax - ymin < 12.0
+    assert r.scale == pytest.approx(800 / 12.0)
+    assert FrameRenderer(world, width_px=800, crop_unknown=False).extent[:3] == (
+        pytest.approx(0.0), pytest.approx(0.0), pytest.approx(40.0))
+
+
 def test_a_still_picture_of_a_world_has_no_empty_text_box(world: StaticWorld) -> None:
     """render_world (map previews) shows no time line, so its corner holds no empty box."""
     from arena.render.frames import render_world

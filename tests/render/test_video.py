@@ -134,13 +134,40 @@ def _episode(n: int) -> tuple[list[SimState], StaticWorld]:
 def test_render_episode(tmp_path: Path) -> None:
     states, world = _episode(12)
     out = render_episode(states, world, tmp_path / "ep.mp4", fps=10, width_px=120,
-                         overlays=lambda i, s: Overlay(text=f"frame {i}"))
+                         overlays=lambda i, s: Overlay(text=f"frame {i}"), legend=False)
     frames = _mp4_frames(out)
     assert len(frames) == 12
     assert frames[0].shape == (80, 120, 3)
     # every=5 draws states 0, 5, 10 and always the last one (11).
-    gif = render_episode(states, world, tmp_path / "ep.gif", every=5, width_px=120)
+    gif = render_episode(states, world, tmp_path / "ep.gif", every=5, width_px=120, legend=False)
     assert iio3.imread(gif, index=None).shape[0] == 4
+
+
+def test_videos_are_readable_by_default(tmp_path: Path) -> None:
+    """At least 720 px wide, even sizes, H.264, with a legend of what the video shows."""
+    states, world = _episode(4)
+    calls: list[int] = []
+
+    def overlay(i: int, s: SimState) -> Overlay:
+        calls.append(i)
+        return Overlay(goals=np.array([[5.0, 3.0, 0.0]]), text=f"frame {i}")
+
+    out = render_episode(states, world, tmp_path / "ep.mp4", overlays=overlay)
+    assert calls == [0, 1, 2, 3]  # each overlay asked for once
+    meta = iio3.immeta(out, extension=".mp4")
+    assert meta["codec"] == "h264"
+    w, h = meta["size"]
+    assert w >= 720 and w % 2 == 0 and h % 2 == 0
+    frames = _mp4_frames(out)
+    assert frames[0].shape == (h, w, 3)
+    # the goal ring is in the legend (right of the map): the robot colour appears there
+    plain = render_episode(states, world, tmp_path / "plain.mp4", legend=False)
+    assert _mp4_frames(plain)[0].shape[1] == w
+    right = frames[-1][:, int(0.85 * w):].astype(int)
+    blue = np.array([31, 119, 180])
+    assert np.any(np.abs(right - blue).max(axis=-1) < 30)
+    assert not np.any(np.abs(_mp4_frames(plain)[-1][:, int(0.85 * w):].astype(int) - blue)
+                      .max(axis=-1) < 30)
 
 
 def test_render_episode_errors(tmp_path: Path) -> None:
