@@ -107,8 +107,8 @@ def test_ray_gives_the_process_results(reference: pa.Table, contest: Path,
     assert _rows(t) == _rows(reference)
     assert _summary(t) == _summary(reference)
     assert ray.is_initialized()  # not ours to shut down
-    assert set(read_manifest(run)) == {"suite", "contest", "seed", "scale", "created",
-                                       "arena_version"}  # nothing backend-specific
+    assert set(read_manifest(run)) == {"suite", "contest", "seed", "scale", "worlds",
+                                       "created", "arena_version"}  # nothing backend-specific
 
 
 class _Stop(Exception):
