@@ -196,8 +196,8 @@ def _run_info(run_dir: Path, cols: dict[str, np.ndarray], contestants: Sequence[
             data = json.loads(manifest.read_text())
             if isinstance(data, dict):
                 info += [(str(k), v if isinstance(v, str) else json.dumps(v)[:300])
-                         for k, v in data.items() if not isinstance(v, dict | list)
-                         or len(json.dumps(v)) <= 300]
+                         for k, v in data.items() if v is not None  # unset: e.g. worlds
+                         and (not isinstance(v, dict | list) or len(json.dumps(v)) <= 300)]
         except (OSError, ValueError):
             pass
     info += [("episodes", str(len(cols["contestant"]))), ("contestants", ", ".join(contestants)),

@@ -139,3 +139,15 @@ def test_summary_html_n_is_episodes_and_cells_with_fewer_values_say_so():
     assert "<td>a</td><td>6</td>" in text
     assert re.search(r'<td>6\.00 <span class="iv">\[[\d.]+, [\d.]+\]</span> '
                      r'<span class="iv">n=5</span></td>', text)
+
+
+def test_run_info_lists_the_manifest_without_unset_fields(tmp_path):
+    import json
+
+    (tmp_path / "run.json").write_text(json.dumps(
+        {"suite": "quick.yaml", "seed": 3, "worlds": None, "scale": 0.5}))
+    cols = {"contestant": np.array(["a", "b"]), "outcome": np.array(["success", "timeout"])}
+    page = report._run_info(tmp_path, cols, ["a", "b"], ["s"])
+    assert ">seed<" in page and ">3<" in page and ">0.5<" in page
+    assert "worlds" not in page and "null" not in page  # no worlds folder given: not listed
+    assert "success: 1, timeout: 1" in page
