@@ -16,27 +16,13 @@ for b in chromium chromium-browser google-chrome google-chrome-stable; do
     fi
 done
 
-if ! command -v apt-get >/dev/null 2>&1; then
-    echo "install_chromium: no apt-get here; install Chromium or Google Chrome with your" \
-         "package manager and put it on PATH" >&2
-    exit 1
-fi
-
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then
-    if command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
-        SUDO="sudo"
-    else
-        echo "install_chromium: needs root (run as root or with sudo)" >&2
-        exit 1
-    fi
-fi
-
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update
+# shellcheck source=tools/apt_lib.sh
+source "$(dirname "$0")/apt_lib.sh"
+apt_prepare install_chromium "install Chromium or Google Chrome with your package manager and put it on PATH"
+apt_get update
 # fonts-dejavu-core: a sans font so the report's text renders in the screenshots.
-if ! $SUDO apt-get install -y --no-install-recommends chromium fonts-dejavu-core; then
-    $SUDO apt-get install -y --no-install-recommends chromium-browser fonts-dejavu-core
+if ! apt_get install -y --no-install-recommends chromium fonts-dejavu-core; then
+    apt_get install -y --no-install-recommends chromium-browser fonts-dejavu-core
 fi
 
 for b in chromium chromium-browser; do

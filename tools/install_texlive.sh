@@ -18,25 +18,11 @@ if have_tex; then
     exit 0
 fi
 
-if ! command -v apt-get >/dev/null 2>&1; then
-    echo "install_texlive: no apt-get here; install a TeX distribution with pdflatex and" \
-         "booktabs (e.g. TeX Live) with your package manager and put it on PATH" >&2
-    exit 1
-fi
-
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then
-    if command -v sudo >/dev/null 2>&1 && sudo -n true 2>/dev/null; then
-        SUDO="sudo"
-    else
-        echo "install_texlive: needs root (run as root or with sudo)" >&2
-        exit 1
-    fi
-fi
-
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update
-$SUDO apt-get install -y --no-install-recommends texlive-latex-base texlive-latex-recommended
+# shellcheck source=tools/apt_lib.sh
+source "$(dirname "$0")/apt_lib.sh"
+apt_prepare install_texlive "install a TeX distribution with pdflatex and booktabs (e.g. TeX Live) with your package manager and put it on PATH"
+apt_get update
+apt_get install -y --no-install-recommends texlive-latex-base texlive-latex-recommended
 
 if have_tex; then
     echo "install_texlive: installed $(command -v pdflatex)"

@@ -24,44 +24,29 @@ import numpy as np
 
 from arena.eval import plots
 from arena.eval.plots import HEADLINE_METRICS
-from arena.eval.stats import MIN_N, RESAMPLES, bootstrap_mean
+from arena.eval.stats import MIN_N, RESAMPLES, Estimate, bootstrap_mean
 
 #: Stage name of the rows over all of a contestant's episodes (not a valid stage name).
 ALL_STAGES = "(all)"
 
 
-@dataclass(frozen=True)
-class SummaryRow:
+@dataclass(frozen=True, kw_only=True)
+class SummaryRow(Estimate):
     """The mean of one metric for one contestant on one stage, with its interval.
+
+    The :class:`~arena.eval.stats.Estimate` (``n``, ``mean``, ``lower``, ``upper``, ``low_n``,
+    ``has_interval``) of one cell, labelled.
 
     Attributes:
         contestant, stage, metric: the group (``stage`` is :data:`ALL_STAGES` for the pooled
             rows).
         unit: the metric's unit from the registry ("" if unregistered).
-        n: number of finite values.
-        mean: their mean (NaN if ``n == 0``).
-        lower, upper: the 95 % percentile-bootstrap interval of the mean (NaN if
-            ``n < MIN_N``).
     """
 
     contestant: str
     stage: str
     metric: str
     unit: str
-    n: int
-    mean: float
-    lower: float
-    upper: float
-
-    @property
-    def low_n(self) -> bool:
-        """True when the cell has values but fewer than :data:`~arena.eval.stats.MIN_N`."""
-        return 0 < self.n < MIN_N
-
-    @property
-    def has_interval(self) -> bool:
-        """True when the interval bounds are finite."""
-        return math.isfinite(self.lower) and math.isfinite(self.upper)
 
 
 def summary_table(
@@ -92,8 +77,9 @@ def summary_table(
                 continue
             for m in names:
                 e = bootstrap_mean(values[m][mask])
-                rows.append(SummaryRow(c, s, m, plots.metric_unit(m), e.n, e.mean, e.lower,
-                                       e.upper))
+                rows.append(SummaryRow(n=e.n, mean=e.mean, lower=e.lower, upper=e.upper,
+                                       confidence=e.confidence, contestant=c, stage=s,
+                                       metric=m, unit=plots.metric_unit(m)))
     return rows
 
 
