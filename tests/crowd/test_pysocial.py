@@ -526,7 +526,8 @@ def test_passes_the_crowd_model_conformance_checks() -> None:
 
 # -- the compiled kernels against their plain NumPy / Python formulations (to the bit) ----------
 def test_desired_kernel_is_desired_force_to_the_bit() -> None:
-    from arena.crowd.models.pysocial import _desired, desired_force
+    from arena.crowd.models.pysocial import desired_force
+    from arena.crowd.models.pysocial.kernels import _desired
 
     rng = np.random.default_rng(11)
     n = 200
@@ -618,7 +619,7 @@ def test_groups_edited_in_place_are_seen() -> None:
 
 def test_nan_max_kernel_is_numpys_max() -> None:
     """The obstacle reach's maximum radius, taken in the kernel, is ``ndarray.max``'s."""
-    from arena.crowd.models.pysocial import _nan_max
+    from arena.crowd.models.pysocial.kernels import _nan_max
 
     rng = np.random.default_rng(3)
     cases = [rng.uniform(0.1, 0.6, n) for n in (1, 2, 7, 40)]
