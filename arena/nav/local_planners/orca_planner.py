@@ -37,7 +37,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import ConfigDict, Field
 
-from arena.crowd.models.orca import RVO_EPSILON, _agent_line, _lp2, _lp3
+from arena.crowd.models.orca.kernels import RVO_EPSILON, _agent_line, _lp2, _lp3
 from arena.nav.local_planners.base import (
     KINEMATICS,
     LOCAL_PLANNERS,
