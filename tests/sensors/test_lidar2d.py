@@ -148,7 +148,7 @@ JACKAL = LidarSpec(angle_min=-2.356, angle_max=2.356, num_beams=720, range_max=3
 @pytest.fixture(autouse=True, params=["faces", "grid"])
 def wall_casting(request, monkeypatch) -> str:
     """Run every test with the walls cast as faces and again by walking the grid."""
-    import arena.sensors.lidar2d as mod
+    import arena.sensors.lidar2d.model as mod
 
     monkeypatch.setattr(mod, "FACES_PER_BEAM", math.inf if request.param == "faces" else -1.0)
     return str(request.param)
@@ -232,7 +232,7 @@ def test_grid_circles_and_segments_combine_as_nearest_hit(seed: int) -> None:
 
 
 def test_batched_grid_cast_equals_scalar_cast() -> None:
-    from arena.sensors.lidar2d import _cast_grid
+    from arena.sensors.lidar2d.grid_kernels import _cast_grid
 
     rng = np.random.default_rng(77)
     for _ in range(5):
@@ -446,7 +446,7 @@ def test_circles_and_segments_match_analytic(seed: int) -> None:
 
 
 def test_fast_atan2_error_bound() -> None:
-    from arena.sensors.lidar2d import ATAN_ERR, _fast_atan2
+    from arena.sensors.lidar2d.kernels import ATAN_ERR, _fast_atan2
 
     t = np.linspace(-math.pi, math.pi, 20001)
     for rad in (1e-3, 1.0, 1e3):

@@ -46,7 +46,7 @@ def test_wall_faces_cover_every_boundary_edge_once() -> None:
 
 
 def test_faces_and_grid_walk_give_identical_ranges(monkeypatch) -> None:
-    import arena.sensors.lidar2d as mod
+    import arena.sensors.lidar2d.model as mod
 
     monkeypatch.setattr(mod, "FACES_PER_BEAM", math.inf)
     rng = np.random.default_rng(11)

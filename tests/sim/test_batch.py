@@ -224,7 +224,7 @@ def test_reset_world_with_another_map_keeps_shared_map(episodes: list[Episode]) 
 def test_scans_bit_identical_to_lidar2d(
     episodes: list[Episode], parallel_min_worlds: int, faces_per_beam: float, monkeypatch
 ) -> None:
-    import arena.sensors.lidar2d as mod
+    import arena.sensors.lidar2d.model as mod
     from arena.sensors.lidar2d import Lidar2D
 
     monkeypatch.setattr(mod, "FACES_PER_BEAM", faces_per_beam)
