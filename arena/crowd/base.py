@@ -35,7 +35,7 @@ from arena.core.registry import Registry
 if TYPE_CHECKING:
     from arena.crowd.neighbors import Neighbors
     from arena.crowd.state import CrowdState
-    from arena.sim.state import StaticWorld
+    from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -18,7 +18,7 @@ from arena.core.errors import ConfigError, MapError
 from arena.core.registry import Registry
 from arena.maps.grid import OccupancyGrid, check_grid_size
 from arena.maps.io import load_map
-from arena.sim.state import Obstacle
+from arena.scene.state import Obstacle
 
 WORLDS_DIR = Path(__file__).resolve().parent.parent / "worlds"
 """Folder of the worlds shipped with Arena (``<name>/map/map.yaml``, ``<name>/scenarios/``)."""

@@ -33,8 +33,8 @@ from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
 from arena.maps.sources import MapResult
 from arena.robots.model import RobotModel
-from arena.sim.state import Obstacle
-from arena.tasks.episode import AgentSpawn, Episode, RobotSpawn
+from arena.scene.episode import AgentSpawn, Episode, RobotSpawn
+from arena.scene.state import Obstacle
 from arena.tasks.world import WorldSampler
 
 Role = Literal["robots", "obstacles", "modules"]

@@ -24,9 +24,9 @@ from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
 from arena.maps.sources import MAP_SOURCES, MapResult, MapSource
 from arena.robots.model import RobotModel
+from arena.scene.episode import Episode
 from arena.tasks.base import ResetContext, build_mode
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import Episode
 from arena.tasks.goal import goal_reached
 from arena.tasks.world import WorldSampler, wall_distance_map
 

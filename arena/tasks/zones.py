@@ -193,7 +193,7 @@ class PedestrianGroup(BaseModel):
 
     @property
     def kind(self) -> int:
-        """Type code of :attr:`~arena.tasks.episode.AgentSpawn.kinds` (0 adult, 1 elder ...)."""
+        """Type code of :attr:`~arena.scene.episode.AgentSpawn.kinds` (0 adult, 1 elder ...)."""
         return KIND_CODES[self.type.removeprefix("human/")]
 
 

@@ -46,7 +46,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.state import CrowdState
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.floating]
 IntArray = NDArray[np.int64]

@@ -68,7 +68,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import WallIndex, world_segments
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -18,9 +18,9 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.config.schema import ExperimentConfig
 from arena.robots.model import RobotModel
+from arena.scene.episode import Episode
 from arena.tasks.base import ModuleBase, ResetContext, build_mode, register_mode
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import Episode
 from arena.tasks.suite import Suite, load_suite
 
 
