@@ -27,7 +27,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-import arena.crowd
+import arena.crowd.base
 import arena.eval.metrics
 import arena.maps.generators
 import arena.maps.sources

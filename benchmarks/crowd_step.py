@@ -24,7 +24,6 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-import arena.crowd  # noqa: E402, F401
 from arena.crowd.base import CROWD_MODELS  # noqa: E402
 from arena.crowd.models.rvo2 import world_polygons  # noqa: E402
 from arena.crowd.simulator import CrowdSimulator, PedestrianConfig  # noqa: E402

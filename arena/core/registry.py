@@ -103,7 +103,9 @@ class Registry(Generic[T]):
         """Register ``obj`` under ``name``; a second plugin with the same name is an error."""
         if not name or name != name.strip() or " " in name:
             raise ValueError(f"invalid {self.kind} name {name!r}")
-        if getattr(obj, "__module__", None) != self._builtins.get(name, "<none>"):
+        declared = self._builtins.get(name)
+        module = str(getattr(obj, "__module__", ""))
+        if declared is not None and not (module == declared or module.startswith(declared + ".")):
             self._load_builtin(name)  # a plugin taking a built-in's name meets the check below
         if name in self._entries and self._entries[name].obj is not obj:
             raise ValueError(
