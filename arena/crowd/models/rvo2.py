@@ -38,6 +38,7 @@ from arena.crowd.models.orca import (
     OrcaParams,
     preferred_velocities,
 )
+from arena.crowd.simulator import episode_segments
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import grid_walls
 from arena.scene.state import StaticWorld
@@ -111,8 +112,6 @@ class Rvo2Model(OrcaModel):
         (:func:`world_polygons`); frames whose walls are the world's segments
         (:func:`~arena.crowd.walls.world_segments`, as the simulator passes them) use them.
         """
-        from arena.crowd.simulator import episode_segments
-
         a, b = episode_segments(world)
         self._convert(a, b, state, world_polygons(world))
 
