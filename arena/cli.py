@@ -290,7 +290,7 @@ def maps_generate(
     from arena.maps.generators import MAP_GENERATORS
     from arena.maps.sources import write_world
     from arena.render import render_world, save_png
-    from arena.sim.state import StaticWorld
+    from arena.scene.state import StaticWorld
 
     spec: dict[str, object] = {"type": kind}
     for text in params or []:
@@ -379,8 +379,8 @@ def tasks_preview(
     """Draw every episode of a suite and print a table (no simulation)."""
     from arena.config.schema import ExperimentConfig
     from arena.robots.presets import load_robot
+    from arena.scene.episode import episode_digest
     from arena.tasks.config import TaskConfig
-    from arena.tasks.episode import episode_digest
     from arena.tasks.generator import TaskGenerator
     from arena.tasks.suite import contestant_config, load_contest
 

@@ -54,9 +54,9 @@ from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack, NavStatus
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
+from arena.scene.episode import Episode
+from arena.scene.state import SimState
 from arena.sim.backend import BACKENDS, SimulatorBackend
-from arena.sim.state import SimState
-from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator, TaskRuntime
 
 

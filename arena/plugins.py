@@ -27,16 +27,14 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-import arena.crowd
+import arena.crowd.base
 import arena.eval.metrics
 import arena.maps.generators
 import arena.maps.sources
 import arena.nav
 import arena.robots
 import arena.sim.native2d
-import arena.tasks.modules
-import arena.tasks.obstacle_modes
-import arena.tasks.robot_modes  # noqa: F401
+import arena.tasks.base  # noqa: F401  (task modes are declared there, imported when named)
 from arena.core.errors import ConfigError, UnknownNameError
 from arena.core.params_doc import describe_params
 from arena.core.registry import Registry, all_registries

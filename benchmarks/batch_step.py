@@ -35,9 +35,9 @@ import numpy as np  # noqa: E402
 from arena.maps.grid import OccupancyGrid  # noqa: E402
 from arena.maps.io import save_map  # noqa: E402
 from arena.robots.presets import load_robot  # noqa: E402
+from arena.scene.episode import Episode  # noqa: E402
 from arena.sim.batch import BatchSim  # noqa: E402
 from arena.tasks.config import TaskConfig  # noqa: E402
-from arena.tasks.episode import Episode  # noqa: E402
 from arena.tasks.generator import TaskGenerator  # noqa: E402
 
 

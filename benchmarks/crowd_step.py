@@ -24,14 +24,13 @@ import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-import arena.crowd  # noqa: E402, F401
 from arena.crowd.base import CROWD_MODELS  # noqa: E402
 from arena.crowd.models.rvo2 import world_polygons  # noqa: E402
 from arena.crowd.simulator import CrowdSimulator, PedestrianConfig  # noqa: E402
 from arena.crowd.walls import world_segments  # noqa: E402
 from arena.maps.grid import OccupancyGrid  # noqa: E402
-from arena.sim.state import RobotStates, StaticWorld  # noqa: E402
-from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn  # noqa: E402
+from arena.scene.episode import WAYPOINT_LOOP, AgentSpawn  # noqa: E402
+from arena.scene.state import RobotStates, StaticWorld  # noqa: E402
 
 RES = 0.1
 

@@ -21,8 +21,8 @@ import numpy as np
 from arena.core.geometry import rectangle
 from arena.maps.grid import OccupancyGrid
 from arena.render import FrameRenderer, Overlay, VideoWriter
+from arena.scene.state import AgentStates, Collisions, Obstacle, RobotStates, SimState, StaticWorld
 from arena.sensors.spec import LidarSpec
-from arena.sim.state import AgentStates, Collisions, Obstacle, RobotStates, SimState, StaticWorld
 
 
 def main() -> None:

@@ -7,7 +7,7 @@ import pytest
 
 from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
-from arena.tasks.episode import AgentSpawn, Episode, RobotSpawn
+from arena.scene.episode import AgentSpawn, Episode, RobotSpawn
 
 
 @pytest.fixture

@@ -17,7 +17,7 @@ import arena.plugins  # noqa: F401
 from arena.core.rng import derive_rng
 from arena.maps.generators import MAP_GENERATORS
 from arena.render import render_world, save_png
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 OUT = Path(__file__).resolve().parent.parent / "docs" / "images" / "generators.png"
 TILE = 360

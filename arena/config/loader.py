@@ -21,9 +21,18 @@ from typing import Any
 import yaml
 from pydantic import ValidationError
 
+import arena.plugins  # noqa: F401  (fills the registries, loads ARENA_PLUGINS)
 from arena.config.schema import ExperimentConfig, non_finite_key
 from arena.core import files
 from arena.core.errors import ConfigError, UnknownNameError, from_validation_error, shorten
+from arena.crowd.base import CROWD_MODELS
+from arena.maps.sources import MAP_SOURCES
+from arena.nav.global_planners.base import GLOBAL_PLANNERS
+from arena.nav.intermediate.base import INTERMEDIATE_PLANNERS
+from arena.nav.local_planners.base import LOCAL_PLANNERS
+from arena.robots.presets import load_robot
+from arena.sim.backend import BACKENDS
+from arena.tasks.base import validate_mode
 
 PRESETS_DIR = Path(__file__).resolve().parent / "presets"
 DEFAULT_CONFIG = PRESETS_DIR / "default.yaml"
@@ -202,16 +211,6 @@ def _resolve_relative_paths(data: dict[str, Any], base: Path) -> None:
 
 def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> None:
     """Check every plugin block and the robot against their registries."""
-    import arena.plugins  # noqa: F401  (fills the registries)
-    from arena.crowd.base import CROWD_MODELS
-    from arena.maps.sources import MAP_SOURCES
-    from arena.nav.global_planners.base import GLOBAL_PLANNERS
-    from arena.nav.intermediate.base import INTERMEDIATE_PLANNERS
-    from arena.nav.local_planners.base import LOCAL_PLANNERS
-    from arena.robots.presets import load_robot
-    from arena.sim.backend import BACKENDS
-    from arena.tasks.base import validate_mode
-
     MAP_SOURCES.validate(cfg.map, source=source, path="map")
     validate_mode("robots", cfg.task.robots, source=source, path="task.robots")
     validate_mode("obstacles", cfg.task.obstacles, source=source, path="task.obstacles")

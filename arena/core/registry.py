@@ -5,6 +5,12 @@ A registry maps stable snake_case names to classes. A class may declare a nested
 against it and constructs ``cls(params)``. Third-party packages add plugins through Python entry
 points in the group given at construction (loaded lazily, on first lookup).
 
+Built-in plugins may be declared by name at construction (``builtins={"random":
+"arena.tasks.robot_modes.random"}``): the registry knows the name at once and imports the module
+(which registers the plugin) only when that name is first looked up. A config is then validated
+without importing every implementation, and a registry never imports the modules that register
+with it (which import the registry), so the import graph stays one-way.
+
 Example::
 
     LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
@@ -21,6 +27,7 @@ Example::
 from __future__ import annotations
 
 import difflib
+import importlib
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
 from importlib.metadata import entry_points as _entry_points
@@ -62,14 +69,23 @@ class Registry(Generic[T]):
     Args:
         kind: human name of the plugin kind, used in messages ("local planner").
         entry_points: entry-point group scanned for third-party plugins ("arena.local_planners").
+        builtins: name -> dotted module that registers that name on import; imported on the
+            first lookup of the name (see the module docstring).
     """
 
-    def __init__(self, kind: str, *, entry_points: str | None = None) -> None:
+    def __init__(
+        self,
+        kind: str,
+        *,
+        entry_points: str | None = None,
+        builtins: Mapping[str, str] | None = None,
+    ) -> None:
         if kind in _ALL:
             raise ValueError(f"a registry for {kind!r} already exists")
         self.kind = kind
         self.entry_point_group = entry_points
         self._entries: dict[str, Entry[T]] = {}
+        self._builtins: dict[str, str] = dict(builtins or {})
         self._entry_points_loaded = entry_points is None
         _ALL[kind] = self
 
@@ -87,6 +103,10 @@ class Registry(Generic[T]):
         """Register ``obj`` under ``name``; a second plugin with the same name is an error."""
         if not name or name != name.strip() or " " in name:
             raise ValueError(f"invalid {self.kind} name {name!r}")
+        declared = self._builtins.get(name)
+        module = str(getattr(obj, "__module__", ""))
+        if declared is not None and not (module == declared or module.startswith(declared + ".")):
+            self._load_builtin(name)  # a plugin taking a built-in's name meets the check below
         if name in self._entries and self._entries[name].obj is not obj:
             raise ValueError(
                 f"duplicate {self.kind} name {name!r}: already registered by "
@@ -100,13 +120,31 @@ class Registry(Generic[T]):
             return
         self._entry_points_loaded = True
         for ep in _entry_points(group=self.entry_point_group or ""):
-            if ep.name in self._entries:
+            if ep.name in self._entries or ep.name in self._builtins:
                 continue  # built-in wins; the duplicate guard is for code registrations
             self.add(ep.name, ep.load(), tags=("third_party",))
+
+    @property
+    def builtins(self) -> dict[str, str]:
+        """The declared built-ins: name -> the module that registers it."""
+        return dict(self._builtins)
+
+    def _load_builtin(self, name: object) -> None:
+        module = self._builtins.get(name) if isinstance(name, str) else None
+        if module is None or name in self._entries:
+            return
+        importlib.import_module(module)
+        if name not in self._entries:
+            raise RuntimeError(f"{module} is declared to register {self.kind} {name!r}, did not")
+
+    def _load_all_builtins(self) -> None:
+        for name in self._builtins:
+            self._load_builtin(name)
 
     def entry(self, name: str) -> Entry[T]:
         """The :class:`Entry` for ``name``; unknown names raise with a close match."""
         self._load_entry_points()
+        self._load_builtin(name)
         try:
             return self._entries[name]
         except KeyError:
@@ -124,25 +162,32 @@ class Registry(Generic[T]):
         return f"unknown {self.kind} {name!r}; {hint}known: {', '.join(known) or '(none)'}"
 
     def names(self, tag: str | None = None) -> list[str]:
-        """Sorted registered names, optionally only those carrying ``tag``."""
+        """Sorted registered names, optionally only those carrying ``tag``.
+
+        Without ``tag`` no built-in module is imported; tags are known only once imported.
+        """
         self._load_entry_points()
-        return sorted(n for n, e in self._entries.items() if tag is None or tag in e.tags)
+        if tag is None:
+            return sorted(self._entries.keys() | self._builtins.keys())
+        self._load_all_builtins()
+        return sorted(n for n, e in self._entries.items() if tag in e.tags)
 
     def entries(self) -> list[Entry[T]]:
-        """All entries, sorted by name."""
+        """All entries, sorted by name (imports every built-in module)."""
         self._load_entry_points()
+        self._load_all_builtins()
         return [self._entries[n] for n in sorted(self._entries)]
 
     def __contains__(self, name: object) -> bool:
         self._load_entry_points()
-        return name in self._entries
+        return name in self._entries or name in self._builtins
 
     def __iter__(self) -> Iterator[str]:
         return iter(self.names())
 
     def __len__(self) -> int:
         self._load_entry_points()
-        return len(self._entries)
+        return len(self._entries.keys() | self._builtins.keys())
 
     # -- construction -----------------------------------------------------------------------
     def validate(

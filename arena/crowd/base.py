@@ -35,7 +35,7 @@ from arena.core.registry import Registry
 if TYPE_CHECKING:
     from arena.crowd.neighbors import Neighbors
     from arena.crowd.state import CrowdState
-    from arena.sim.state import StaticWorld
+    from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -130,4 +130,16 @@ class CrowdModel(Protocol):
         ...
 
 
-CROWD_MODELS: Registry[CrowdModel] = Registry("crowd model", entry_points="arena.crowd_models")
+_BUILTIN_MODELS = {
+    "bonding": "bonding", "deep_social_force": "deep_social_force", "evacuation": "evacuation",
+    "orca": "orca", "passthrough": "pedsim", "pedsim": "pedsim", "pysocial": "pysocial",
+    "rvo2": "rvo2", "spinny": "spinny", "waypoint_walker": "walker",
+}
+
+CROWD_MODELS: Registry[CrowdModel] = Registry(
+    "crowd model",
+    entry_points="arena.crowd_models",
+    # name -> the module of arena.crowd.models registering it, imported when first named: a
+    # config naming one model does not compile the others
+    builtins={name: f"arena.crowd.models.{module}" for name, module in _BUILTIN_MODELS.items()},
+)

@@ -50,7 +50,7 @@ def integrate(
     Args:
         walls: the static segments (indexed).
         clearance_map: ``(H, W)`` distance (m) from each cell centre to the nearest wall,
-            obstacle or map edge, minus half a cell (:func:`arena.tasks.sampling.clearance_map`);
+            obstacle or map edge, minus half a cell (:func:`arena.maps.distance.clearance_map`);
             agents clearly farther from every wall than their step skip the exact test.
         grid_origin: ``(x, y)`` of the map's lower-left corner (m).
         resolution: cell size (m).

@@ -26,13 +26,14 @@ from pydantic import BaseModel, ConfigDict, Field
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, CrowdModel, RobotView
 from arena.crowd.integrator import integrate
 from arena.crowd.neighbors import find_neighbors
-from arena.crowd.state import CrowdState, StartupMode
-from arena.crowd.walls import WallIndex, grid_wall_segments
+from arena.crowd.social import SocialStates
+from arena.crowd.state import CrowdState, StartupMode, leaders_of
+from arena.crowd.walls import WallIndex, grid_walls
+from arena.maps.distance import clearance_map, grid_memo, lower_envelope, squared_edt
 from arena.maps.grid import OccupancyGrid
 from arena.maps.raster import polygon_window
-from arena.sim.state import AgentStates, RobotStates, StaticWorld
-from arena.tasks.episode import WAYPOINT_RANDOM, AgentSpawn
-from arena.tasks.sampling import clearance_map, grid_memo, lower_envelope, squared_edt
+from arena.scene.episode import WAYPOINT_RANDOM, AgentSpawn
+from arena.scene.state import AgentStates, RobotStates, StaticWorld
 
 FloatArray = NDArray[np.float64]
 
@@ -108,8 +109,6 @@ class CrowdSimulator:
         elder = state.kinds == 1
         state.vmax = np.where(elder, state.vmax * cfg.elder_speed_factor, state.vmax)
         if spawn.groups is None and len(state) > 1 and cfg.group_fraction > 0:
-            from arena.crowd.state import leaders_of
-
             state.group = form_groups(state.positions, cfg, rng)
             state.leader = leaders_of(state.group)
         self._walls_a, self._walls_b = episode_segments(world)
@@ -128,8 +127,6 @@ class CrowdSimulator:
         if cfg.initial_levels == "random":
             state.stress, state.energy, state.social = rng.random((3, len(state)))
         if cfg.social_states:
-            from arena.crowd.social import SocialStates
-
             self.social = SocialStates()
             self.social.reset(state, world, rng)
         self._update_destinations()
@@ -277,34 +274,6 @@ class CrowdSimulator:
         )
 
 
-_GRID_WALLS: list[tuple[NDArray[np.bool_], tuple[float, ...], float, FloatArray, FloatArray]] = []
-"""The last map's wall segments (at most one entry): see :func:`grid_walls`."""
-
-
-def grid_walls(grid: OccupancyGrid) -> tuple[FloatArray, FloatArray]:
-    """:func:`~arena.crowd.walls.grid_wall_segments` of ``grid`` (``border=True``), cached.
-
-    Tracing the walls costs milliseconds and every episode reset asks for them several times
-    (simulator, crowd model, social states) on a map that rarely changes. The single-entry
-    cache compares the occupancy (a copy, so in-place edits are seen), origin and resolution;
-    the arrays it returns are read-only and the same objects while the map stays the same.
-    """
-    occ = np.asarray(grid.occupied)
-    origin = tuple(float(v) for v in grid.origin)
-    res = float(grid.resolution)
-    if _GRID_WALLS:
-        c_occ, c_origin, c_res, a, b = _GRID_WALLS[0]
-        if c_origin == origin and c_res == res and c_occ.shape == occ.shape and np.array_equal(
-            c_occ, occ
-        ):
-            return a, b
-    a, b = grid_wall_segments(grid)
-    a.flags.writeable = False
-    b.flags.writeable = False
-    _GRID_WALLS[:] = [(occ.copy(), origin, res, a, b)]
-    return a, b
-
-
 def crowd_clearance(grid: OccupancyGrid, polygons: list[FloatArray]) -> FloatArray:
     """The integrator's distance map: ``clearance_map(grid, occupied | polygon_mask(polygons))``.
 
@@ -401,7 +370,7 @@ def _lower_clearance(
     ``win`` ``(h, w)`` bool has its cell ``(0, 0)`` at map cell ``(r0, c0)``; the box is map
     rows ``[br0, br1)``, columns ``[bc0, bc1)`` and contains it. ``d²`` is the exact squared
     distance (cells²) to the nearest ``win`` cell (Felzenszwalb–Huttenlocher, as
-    :func:`~arena.tasks.sampling.squared_edt` but with no blocked border, over the footprint's
+    :func:`~arena.maps.distance.squared_edt` but with no blocked border, over the footprint's
     columns only: the others hold no footprint cell). Cells where ``d²`` is not below the
     map's own ``sq`` keep their value without a square root (``out`` is at most the map's).
     """

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 if TYPE_CHECKING:
-    from arena.tasks.episode import AgentSpawn
+    from arena.scene.episode import AgentSpawn
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -16,7 +16,7 @@ from numpy.typing import NDArray
 
 from arena.crowd.neighbors import CellList, Neighbors
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 
@@ -52,6 +52,34 @@ def grid_wall_segments(
     if not a_list:
         return np.zeros((0, 2)), np.zeros((0, 2))
     return np.array(a_list, dtype=np.float64), np.array(b_list, dtype=np.float64)
+
+
+_GRID_WALLS: list[tuple[NDArray[np.bool_], tuple[float, ...], float, FloatArray, FloatArray]] = []
+"""The last map's wall segments (at most one entry): see :func:`grid_walls`."""
+
+
+def grid_walls(grid: OccupancyGrid) -> tuple[FloatArray, FloatArray]:
+    """:func:`~arena.crowd.walls.grid_wall_segments` of ``grid`` (``border=True``), cached.
+
+    Tracing the walls costs milliseconds and every episode reset asks for them several times
+    (simulator, crowd model, social states) on a map that rarely changes. The single-entry
+    cache compares the occupancy (a copy, so in-place edits are seen), origin and resolution;
+    the arrays it returns are read-only and the same objects while the map stays the same.
+    """
+    occ = np.asarray(grid.occupied)
+    origin = tuple(float(v) for v in grid.origin)
+    res = float(grid.resolution)
+    if _GRID_WALLS:
+        c_occ, c_origin, c_res, a, b = _GRID_WALLS[0]
+        if c_origin == origin and c_res == res and c_occ.shape == occ.shape and np.array_equal(
+            c_occ, occ
+        ):
+            return a, b
+    a, b = grid_wall_segments(grid)
+    a.flags.writeable = False
+    b.flags.writeable = False
+    _GRID_WALLS[:] = [(occ.copy(), origin, res, a, b)]
+    return a, b
 
 
 def _runs(mask: NDArray[np.bool_]) -> list[tuple[int, int, int]]:

@@ -25,12 +25,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from arena.crowd.simulator import CrowdSimulator
+from arena.scene.state import RobotStates, StaticWorld
 from arena.sim.backend import split_rng
-from arena.sim.state import RobotStates, StaticWorld
 
 if TYPE_CHECKING:
     from arena.crowd.simulator import PedestrianConfig
-    from arena.tasks.episode import Episode
+    from arena.scene.episode import Episode
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -52,7 +52,7 @@ class CrowdTrack:
 
 
 def no_robots() -> RobotStates:
-    """An empty :class:`~arena.sim.state.RobotStates` (what the crowd sees in the replay)."""
+    """An empty :class:`~arena.scene.state.RobotStates` (what the crowd sees in the replay)."""
     return RobotStates(
         names=(), models=(), poses=np.zeros((0, 3)), twists=np.zeros((0, 3)),
         commands=np.zeros((0, 3)), radii=np.zeros(0), footprints=(), scans=(),
@@ -73,7 +73,7 @@ def replay_crowd(
         crowd_config: the experiment's ``crowd`` block (model type and parameters).
         pedestrian_config: the experiment's ``pedestrians`` block
             (:class:`~arena.crowd.simulator.PedestrianConfig`).
-        episode: the :class:`~arena.tasks.episode.Episode` as it was run.
+        episode: the :class:`~arena.scene.episode.Episode` as it was run.
         steps: number of steps after reset (the record has ``steps + 1`` rows).
         dt: s, the simulation step.
         rng: the generator the backend's ``reset`` received for this episode (it is split the

@@ -14,7 +14,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from arena.eval.record import EpisodeMeta, EpisodeRecord
-from arena.sim.state import SimState
+from arena.scene.state import SimState
 
 FloatArray = NDArray[np.float64]
 

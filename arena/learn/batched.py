@@ -63,8 +63,8 @@ from arena.learn.prefetch import EpisodePrefetcher
 from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
+from arena.scene.episode import Episode
 from arena.sim.batch import BatchSim, BatchState
-from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator
 
 F64 = NDArray[np.float64]

@@ -44,9 +44,9 @@ from arena.maps.raster import polygon_mask
 from arena.nav.global_planners.astar import AStarPlanner
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
+from arena.scene.episode import Episode
+from arena.scene.state import SimState
 from arena.sim.backend import BACKENDS, SimulatorBackend
-from arena.sim.state import SimState
-from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.robot_modes.random import sample_start_goal, spawn_radius
 from arena.tasks.world import WorldSampler

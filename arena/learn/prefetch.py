@@ -50,7 +50,7 @@ from typing import Any
 
 from arena.maps.grid import OccupancyGrid
 from arena.robots.model import RobotModel
-from arena.tasks.episode import Episode
+from arena.scene.episode import Episode
 
 #: Builds the task generator placing ``robot`` for ``(seed, stage)`` (stage ``None``: no
 #: curriculum stage set).

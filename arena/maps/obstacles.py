@@ -1,7 +1,7 @@
 """The static obstacle model library: footprints and heights as data (``obstacle_models.yaml``).
 
 Scenario files, task modes and map generators place obstacles by model name; this module turns
-a name and a pose into an :class:`~arena.sim.state.Obstacle` with a real footprint polygon
+a name and a pose into an :class:`~arena.scene.state.Obstacle` with a real footprint polygon
 (circles become 16-gons, so lidar and collisions see their true shape within 2 % of the radius).
 """
 
@@ -19,7 +19,7 @@ from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationError
 
 from arena.core.errors import UnknownNameError, from_validation_error
 from arena.core.geometry import rectangle, regular_polygon
-from arena.sim.state import Obstacle
+from arena.scene.state import Obstacle
 
 LIBRARY = Path(__file__).with_name("obstacle_models.yaml")
 CIRCLE_SIDES = 16

@@ -102,7 +102,7 @@ def burn_obstacles(grid: OccupancyGrid, obstacles: Sequence[Any]) -> OccupancyGr
 
     What the global planner plans on, and what ``arena maps generate --burn-obstacles`` writes
     so that map-only tools (ROS ``map_server``, RViz) see placed obstacles. ``obstacles``: any
-    objects with a ``polygon`` ``(k, 2)`` in metres (:class:`~arena.sim.state.Obstacle`).
+    objects with a ``polygon`` ``(k, 2)`` in metres (:class:`~arena.scene.state.Obstacle`).
     """
     if not obstacles:
         return grid

@@ -7,6 +7,7 @@ generators here as well.
 
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol
@@ -15,10 +16,12 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 from arena.core.errors import ConfigError, MapError
+from arena.core.files import make_dir
 from arena.core.registry import Registry
 from arena.maps.grid import OccupancyGrid, check_grid_size
-from arena.maps.io import load_map
-from arena.sim.state import Obstacle
+from arena.maps.io import load_map, save_map
+from arena.maps.raster import burn_obstacles as burn
+from arena.scene.state import Obstacle
 
 WORLDS_DIR = Path(__file__).resolve().parent.parent / "worlds"
 """Folder of the worlds shipped with Arena (``<name>/map/map.yaml``, ``<name>/scenarios/``)."""
@@ -251,12 +254,6 @@ def write_world(
     ``burn_obstacles`` the cells the obstacles overlap are occupied in ``map.png`` too, so that
     tools that read only the map (ROS ``map_server``, RViz, ``arena run --map FOLDER``) see them.
     """
-    import json
-
-    from arena.core.files import make_dir
-    from arena.maps.io import save_map
-    from arena.maps.raster import burn_obstacles as burn
-
     folder = make_dir(folder, what="world folder")
     grid = burn(result.grid, result.obstacles) if burn_obstacles else result.grid
     yaml_path = save_map(grid, folder / "map" / "map.yaml", image_format="png")

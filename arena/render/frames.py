@@ -45,8 +45,8 @@ from arena.render.mapview import (
     scale_bar_height_px,
     scale_bar_length,
 )
+from arena.scene.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 from arena.sensors.spec import LidarSpec
-from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 
 FloatArray = NDArray[np.float64]
 
@@ -66,7 +66,7 @@ readable in a report or on a slide."""
 class Overlay:
     """Planner and task information drawn on top of a state (all optional).
 
-    Robot-indexed fields follow the robot order of :class:`~arena.sim.state.RobotStates`; a
+    Robot-indexed fields follow the robot order of :class:`~arena.scene.state.RobotStates`; a
     ``None`` entry (or a row of NaN) means "nothing for this robot".
 
     Attributes:

@@ -17,7 +17,7 @@ import numpy as np
 from arena.core.errors import ConfigError
 from arena.maps.grid import UNKNOWN, OccupancyGrid
 from arena.render.legend import DPI, legend_size, text_size
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 MAX_WIDTH_PX = 8000
 """Widest frame drawn (pixels): an 8K image; wider ones take gigabytes for nothing."""

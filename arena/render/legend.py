@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     from matplotlib.backends.backend_agg import RendererAgg
 
     from arena.render.frames import Overlay
-    from arena.sim.state import SimState
+    from arena.scene.state import SimState
 
 DPI = 100.0
 """Frame resolution (pixels per inch): sizes in pixels are ``points · DPI / 72``."""

@@ -17,8 +17,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import ArenaError, ConfigError
 from arena.render.frames import DEFAULT_WIDTH_PX
+from arena.scene.state import SimState, StaticWorld
 from arena.sensors.spec import LidarSpec
-from arena.sim.state import SimState, StaticWorld
 
 VIDEO_EXTENSIONS = (".mp4", ".gif")
 # x264 constant-rate factor: 20 keeps thin lines and small text sharp at a modest size.

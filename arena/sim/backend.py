@@ -13,11 +13,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from arena.core.registry import Registry
-from arena.sim.state import AgentStates, RobotStates, SimState, StaticWorld
+from arena.scene.state import AgentStates, RobotStates, SimState, StaticWorld
 
 if TYPE_CHECKING:
     from arena.core.types import Pose2D
-    from arena.tasks.episode import AgentSpawn, Episode
+    from arena.scene.episode import AgentSpawn, Episode
 
 
 @runtime_checkable

@@ -21,6 +21,7 @@ During an episode the robot mode decides what happens when a robot reaches its g
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal, Protocol
@@ -33,8 +34,8 @@ from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
 from arena.maps.sources import MapResult
 from arena.robots.model import RobotModel
-from arena.sim.state import Obstacle
-from arena.tasks.episode import AgentSpawn, Episode, RobotSpawn
+from arena.scene.episode import AgentSpawn, Episode, RobotSpawn
+from arena.scene.state import Obstacle
 from arena.tasks.world import WorldSampler
 
 Role = Literal["robots", "obstacles", "modules"]
@@ -174,7 +175,23 @@ class SingleGoal:
         return None
 
 
-TASK_MODES: Registry[Any] = Registry("task mode", entry_points="arena.task_modes")
+_BUILTIN_MODES = {
+    "robots": ("explore", "guided", "random", "scenario", "zones"),
+    "obstacles": ("parametrized", "random", "scenario", "zones"),
+    "modules": ("benchmark", "clear_forbidden_zones", "dynamic_map", "interactive", "staged"),
+}
+_PACKAGES = {"robots": "robot_modes", "obstacles": "obstacle_modes", "modules": "modules"}
+
+TASK_MODES: Registry[Any] = Registry(
+    "task mode",
+    entry_points="arena.task_modes",
+    # <role>.<name> -> arena.tasks.<role package>.<name>, imported when the mode is first named
+    builtins={
+        f"{role}.{name}": f"arena.tasks.{_PACKAGES[role]}.{name}"
+        for role, names in _BUILTIN_MODES.items()
+        for name in names
+    },
+)
 """Every task mode, named ``<role>.<name>`` and tagged with its role."""
 
 
@@ -187,14 +204,13 @@ def register_mode(
 
 def mode_names(role: Role) -> list[str]:
     """Short names of the modes of one role (``["explore", "guided", "random", ...]``)."""
-    _load_builtin_modes()
-    return [n.split(".", 1)[1] for n in TASK_MODES.names(role)]
+    prefix = f"{role}."
+    return [n.removeprefix(prefix) for n in TASK_MODES.names() if n.startswith(prefix)]
 
 
 def _qualified(
     role: Role, spec: Mapping[str, Any] | str, *, source: str | None, path: str | None
 ) -> dict[str, Any]:
-    _load_builtin_modes()
     if isinstance(spec, str):
         spec = {"type": spec}
     if not isinstance(spec, Mapping):
@@ -209,8 +225,6 @@ def _qualified(
         )
     name = spec["type"]
     if f"{role}.{name}" not in TASK_MODES:
-        import difflib
-
         known = mode_names(role)
         close = difflib.get_close_matches(str(name), known, n=1, cutoff=0.5)
         hint = f"did you mean {close[0]!r}? " if close else ""
@@ -220,13 +234,6 @@ def _qualified(
             path=".".join(p for p in (path, "type") if p),
         )
     return {**spec, "type": f"{role}.{name}"}
-
-
-def _load_builtin_modes() -> None:
-    # Imported on first use: the mode modules import this one.
-    import arena.tasks.modules
-    import arena.tasks.obstacle_modes
-    import arena.tasks.robot_modes  # noqa: F401
 
 
 def validate_mode(

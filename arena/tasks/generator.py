@@ -24,9 +24,10 @@ from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
 from arena.maps.sources import MAP_SOURCES, MapResult, MapSource
 from arena.robots.model import RobotModel
+from arena.robots.presets import load_robot
+from arena.scene.episode import Episode
 from arena.tasks.base import ResetContext, build_mode
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import Episode
 from arena.tasks.goal import goal_reached
 from arena.tasks.world import WorldSampler, wall_distance_map
 
@@ -79,8 +80,6 @@ class TaskGenerator:
     @classmethod
     def from_config(cls, cfg: ExperimentConfig, robots: Sequence[RobotModel] | None = None):
         """The generator of an experiment config (robots default to ``cfg.robot``)."""
-        from arena.robots.presets import load_robot
-
         return cls(
             cfg.task,
             map_spec=cfg.map,
@@ -323,6 +322,8 @@ class TaskRuntime:
 
     def _apply(self, upd: TaskUpdate, cmd: Any, time: float) -> None:
         """Apply one interactive command (``TaskCommand``) to the running episode."""
+        # the interactive mode is imported when a config names it (TASK_MODES), and only it
+        # sends commands
         from arena.tasks.modules.interactive import CommandError
 
         if cmd.kind == "reset":

@@ -86,8 +86,7 @@ from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle, obstacle_model
 from arena.robots.model import RobotModel
-from arena.sim.state import Obstacle
-from arena.tasks.episode import (
+from arena.scene.episode import (
     MAX_COUNT,
     MAX_PERSON_SPEED,
     WAYPOINT_LOOP,
@@ -96,11 +95,11 @@ from arena.tasks.episode import (
     RobotSpawn,
     speed_range_problem,
 )
+from arena.scene.state import Obstacle
+from arena.tasks.scenario_checks import DEFAULT_PED_RADIUS, check_layout, validate_against_map
 
 DEFAULT_VMAX = 0.3
 """m/s, Arena's task-generator default ``VMAX`` for a pedestrian without a ``vmax`` (§5.3)."""
-DEFAULT_PED_RADIUS = 0.3
-"""m, body radius of a scenario pedestrian (the format has no radius key)."""
 DEFAULT_PED_MODEL = "actor1"
 """Arena's default pedestrian model name."""
 
@@ -160,7 +159,7 @@ N((lo+hi)/2, (hi−lo)/6) clipped."""
 Probability = Annotated[Param, AfterValidator(_check_probability)]
 """A :data:`Param` in [0, 1]."""
 Speed = Annotated[Param, AfterValidator(_check_speed)]
-"""A :data:`Param` in m/s within [0, :data:`~arena.tasks.episode.MAX_PERSON_SPEED`]."""
+"""A :data:`Param` in m/s within [0, :data:`~arena.scene.episode.MAX_PERSON_SPEED`]."""
 
 
 # NaN or infinity is never a valid coordinate or parameter (Python's json accepts them).
@@ -499,8 +498,6 @@ def parse_scenario(text: str, *, source: str | None = None) -> Scenario:
                 obstacle_model(_model_name(o.model))
             except UnknownNameError as e:
                 raise e.located(source=source, prefix=f"obstacles.{group}[{i}].model") from None
-    from arena.tasks.scenario_checks import check_layout
-
     check_layout(scenario, source=source)
     return scenario
 
@@ -527,7 +524,6 @@ def validate_file(path: str | Path, map_yaml: str | Path | None = None) -> list[
         ConfigError: the first error, naming the file and the entry.
     """
     from arena.maps.io import load_map  # map images are only needed when a map is given
-    from arena.tasks.scenario_checks import validate_against_map
 
     scenario = load_scenario(path)
     findings = list(scenario.warnings)

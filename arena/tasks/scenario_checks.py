@@ -11,16 +11,23 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from arena.core.errors import ConfigError
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import Obstacle
-from arena.tasks.episode import RobotSpawn
-from arena.tasks.scenario import DEFAULT_PED_RADIUS, Scenario
+from arena.scene.episode import RobotSpawn
+from arena.scene.state import Obstacle, StaticWorld
+from arena.sim.native2d.collisions import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
+
+if TYPE_CHECKING:  # read, never built here: scenario.py imports these checks
+    from arena.tasks.scenario import Scenario
 
 _ROBOT, _PERSON, _OBSTACLE = "robot", "person", "obstacle"
+
+DEFAULT_PED_RADIUS = 0.3
+"""m, body radius of a scenario pedestrian (the format has no radius key)."""
 
 
 def _points(scenario: Scenario) -> list[tuple[str, Sequence[float], str]]:
@@ -174,14 +181,6 @@ def check_robot_bodies(
     Raises:
         ConfigError: ``robots[k].start`` (or ``.goal``) and what the body overlaps.
     """
-    from arena.sim.native2d.collisions import (
-        Footprint,
-        ObstacleIndex,
-        first_obstacle_hit,
-        hits_grid,
-    )
-    from arena.sim.state import StaticWorld
-
     index = ObstacleIndex.build(StaticWorld.build(grid, tuple(obstacles)))
     for k, spawn in enumerate(spawns):
         model = spawn.model

@@ -43,12 +43,13 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StrictInt, ValidationError, field_validator
 
-from arena.config.loader import merge
+from arena.config.loader import merge, validate_plugins
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, from_validation_error
 from arena.core.names import RULE, SafeName
 from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, check_worlds_folder, resolve_world
+from arena.nav.local_planners.base import LOCAL_PLANNERS
 from arena.tasks.datafiles import find_data_file, read_arena_yaml
 from arena.tasks.suite_worlds import find_stage_world
 
@@ -430,8 +431,6 @@ class Suite:
             ConfigError: a missing world or scenario, an unknown mode or model, naming the
                 suite file and the stage's key path (``stages[3].map``).
         """
-        from arena.config.loader import validate_plugins
-
         base = base_cfg.model_dump(mode="json")
         st = self.stages[i]
         map_block = self.stage_map(i, base["map"])
@@ -548,8 +547,6 @@ def contestant_config(
     ``inter_planner`` is Arena's intermediate planner; ``bypass`` passes the global path
     through, which is what our stack does, so it needs no setting here.
     """
-    from arena.nav.local_planners.base import LOCAL_PLANNERS
-
     where = f"contestants[{index}].local_planner"
     try:
         LOCAL_PLANNERS.entry(contestant.local_planner)

@@ -26,10 +26,11 @@ from numpy.typing import NDArray
 
 from arena.core.errors import SamplingError
 from arena.core.geometry import points_in_polygon
+from arena.maps.distance import grid_memo, squared_edt
 from arena.maps.grid import OccupancyGrid
 from arena.maps.raster import disk_mask, or_disk, polygon_mask, polygon_window
-from arena.sim.state import Obstacle
-from arena.tasks.sampling import MaskRegions, accept_spaced, grid_memo, squared_edt
+from arena.scene.state import Obstacle
+from arena.tasks.sampling import MaskRegions, accept_spaced
 
 FloatArray = NDArray[np.float64]
 

@@ -52,6 +52,7 @@ from pydantic import (
 )
 
 from arena.core.errors import ConfigError, SamplingError, from_validation_error
+from arena.core.geometry import points_in_polygon
 from arena.maps.sources import resolve_world
 from arena.tasks.datafiles import read_yaml_any
 from arena.tasks.scenario import KIND_CODES
@@ -193,7 +194,7 @@ class PedestrianGroup(BaseModel):
 
     @property
     def kind(self) -> int:
-        """Type code of :attr:`~arena.tasks.episode.AgentSpawn.kinds` (0 adult, 1 elder ...)."""
+        """Type code of :attr:`~arena.scene.episode.AgentSpawn.kinds` (0 adult, 1 elder ...)."""
         return KIND_CODES[self.type.removeprefix("human/")]
 
 
@@ -253,8 +254,6 @@ class ZoneMap:
 
     def contains(self, points: FloatArray, categories: Categories) -> NDArray[np.bool_]:
         """Which of the ``(n, 2)`` points (m) lie inside a zone of one of ``categories``."""
-        from arena.core.geometry import points_in_polygon
-
         p = np.asarray(points, dtype=np.float64).reshape(-1, 2)
         inside = np.zeros(len(p), dtype=bool)
         for cat in self.expand(categories):

@@ -8,8 +8,8 @@ from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
 from arena.maps.sources import MapResult, MapSource
 from arena.robots.presets import load_robot
-from arena.sim.state import RobotStates, SimState, StaticWorld
-from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn, Episode, RobotSpawn
+from arena.scene.episode import WAYPOINT_LOOP, AgentSpawn, Episode, RobotSpawn
+from arena.scene.state import RobotStates, SimState, StaticWorld
 
 
 def standard_episode(n_agents: int = 6) -> Episode:
@@ -221,8 +221,8 @@ def check_task_mode(
     start and end with their body clear of walls, obstacles and people inside the map's free
     space, positive time limits, and that ``next_goal`` answers a goal in free space or ``None``.
     """
+    from arena.scene.episode import episode_digest
     from arena.tasks.config import TaskConfig
-    from arena.tasks.episode import episode_digest
     from arena.tasks.generator import TaskGenerator
     from arena.tasks.world import WorldSampler
 

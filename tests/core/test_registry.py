@@ -1,6 +1,9 @@
+import sys
+
 import pytest
 from pydantic import BaseModel, ConfigDict, Field
 
+from arena.core import registry as registry_module
 from arena.core.errors import ConfigError, UnknownNameError
 from arena.core.registry import Registry, all_registries
 
@@ -113,3 +116,49 @@ def test_entry_points_are_loaded(monkeypatch):
     reg = Registry("test kind h", entry_points="x.y")
     assert reg.names() == ["third"]
     assert reg.entry("third").tags == ("third_party",)
+
+
+def _builtin_module(tmp_path, monkeypatch, kind: str, name: str, registers: bool) -> str:
+    # the registry made by the test is dropped afterwards: `arena plugins` lists every registry
+    monkeypatch.setattr(registry_module, "_ALL", dict(all_registries()))
+    module = f"arena_test_builtin_{name}"
+    body = (
+        "from arena.core.registry import all_registries\n"
+        f"REG = all_registries()[{kind!r}]\n"
+        "class Model:\n"
+        "    '''A lazily imported built-in.'''\n"
+    )
+    if registers:
+        body += f"REG.add({name!r}, Model)\n"
+    (tmp_path / f"{module}.py").write_text(body)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    return module
+
+
+def test_builtin_names_are_known_before_their_module_is_imported(tmp_path, monkeypatch):
+    module = _builtin_module(tmp_path, monkeypatch, "test kind lazy a", "walker", registers=True)
+    reg = Registry("test kind lazy a", builtins={"walker": module})
+    assert reg.names() == ["walker"] and "walker" in reg and len(reg) == 1
+    assert module not in sys.modules  # listing and membership import nothing
+    assert reg.get("walker").__module__ == module  # the first lookup imports it
+    assert module in sys.modules
+
+
+def test_a_plugin_taking_a_builtin_name_is_a_duplicate(tmp_path, monkeypatch):
+    module = _builtin_module(tmp_path, monkeypatch, "test kind lazy b", "spinny", registers=True)
+    reg = Registry("test kind lazy b", builtins={"spinny": module})
+
+    class Mine:
+        pass
+
+    with pytest.raises(ValueError, match=f"duplicate test kind lazy b name 'spinny': already "
+                                         f"registered by {module}.Model"):
+        reg.add("spinny", Mine)
+
+
+def test_a_builtin_module_that_does_not_register_its_name_fails_loudly(tmp_path, monkeypatch):
+    module = _builtin_module(tmp_path, monkeypatch, "test kind lazy c", "ghost", registers=False)
+    reg = Registry("test kind lazy c", builtins={"ghost": module})
+    with pytest.raises(RuntimeError, match=f"{module} is declared to register test kind lazy c "
+                                           "'ghost', did not"):
+        reg.get("ghost")

@@ -16,7 +16,7 @@ from arena.crowd.models import deep_social_force as dsf_module
 from arena.crowd.models.deep_social_force import WEIGHTS, DeepSocialForce, MLPPotential, _dvdb
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
-from arena.tasks.episode import AgentSpawn
+from arena.scene.episode import AgentSpawn
 from arena.testing.conformance import check_crowd_model
 
 V0, SIGMA, DT_B = 2.1, 0.3, 0.4  # the generator potential the weights were trained on

@@ -13,8 +13,8 @@ from arena.crowd.models.evacuation import Evacuation
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import StaticWorld
-from arena.tasks.episode import AgentSpawn
+from arena.scene.episode import AgentSpawn
+from arena.scene.state import StaticWorld
 from arena.testing.conformance import check_crowd_model
 
 A, B, K, KAPPA, M, TAU = 2000.0, 0.08, 1.2e5, 2.4e5, 80.0, 0.5

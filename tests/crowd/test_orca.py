@@ -23,8 +23,8 @@ from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import grid_wall_segments, world_segments
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import Obstacle, StaticWorld
-from arena.tasks.episode import AgentSpawn
+from arena.scene.episode import AgentSpawn
+from arena.scene.state import Obstacle, StaticWorld
 
 DT = 0.1
 RADIUS = 0.3

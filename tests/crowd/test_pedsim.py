@@ -15,8 +15,8 @@ from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import grid_wall_segments
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import StaticWorld
-from arena.tasks.episode import AgentSpawn
+from arena.scene.episode import AgentSpawn
+from arena.scene.state import StaticWorld
 
 NO_WALLS = (np.zeros((0, 2)), np.zeros((0, 2)))
 

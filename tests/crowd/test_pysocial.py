@@ -24,8 +24,8 @@ from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import world_segments
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import Obstacle, StaticWorld
-from arena.tasks.episode import AgentSpawn
+from arena.scene.episode import AgentSpawn
+from arena.scene.state import Obstacle, StaticWorld
 from arena.testing.conformance import check_crowd_model
 
 # PySocialForce's term order in Simulator.forces (enable_group): desired, social, obstacle,

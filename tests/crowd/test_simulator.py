@@ -7,8 +7,8 @@ from arena.crowd.simulator import CrowdSimulator, PedestrianConfig, form_groups,
 from arena.crowd.state import SocialState, StartupMode
 from arena.crowd.walls import WallIndex, grid_wall_segments
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import Obstacle, RobotStates, StaticWorld
-from arena.tasks.episode import WAYPOINT_LOOP, WAYPOINT_RANDOM, AgentSpawn
+from arena.scene.episode import WAYPOINT_LOOP, WAYPOINT_RANDOM, AgentSpawn
+from arena.scene.state import Obstacle, RobotStates, StaticWorld
 
 WORLD = StaticWorld.build(OccupancyGrid.empty(20, 20, 0.1))
 NO_ROBOTS = RobotStates(
@@ -268,7 +268,7 @@ def test_inputs_not_mutated():
 
 def test_compiled_integrator_matches_guard_reference():
     from arena.crowd.integrator import integrate
-    from arena.tasks.sampling import clearance_map
+    from arena.maps.distance import clearance_map
 
     occ = np.zeros((100, 100), dtype=bool)
     occ[:, 50] = True  # a thin wall through the middle
@@ -315,8 +315,8 @@ def test_compiled_integrator_matches_guard_reference():
 
 def test_grid_walls_are_cached_per_map():
     """Same map: the same read-only arrays; another occupancy: traced again."""
-    from arena.crowd.simulator import episode_segments, grid_walls
-    from arena.crowd.walls import world_segments
+    from arena.crowd.simulator import episode_segments
+    from arena.crowd.walls import grid_walls, world_segments
 
     occ = np.zeros((30, 40), dtype=bool)
     occ[10:20, 5:8] = True
@@ -390,7 +390,7 @@ def test_robot_view_and_headings_are_the_numpy_expressions():
 
 def test_integrate_factors_are_the_premultiplied_arrays():
     from arena.crowd.integrator import integrate
-    from arena.tasks.sampling import clearance_map
+    from arena.maps.distance import clearance_map
 
     occ = np.zeros((60, 60), dtype=bool)
     occ[:, 30] = occ[0, :] = occ[-1, :] = occ[:, 0] = occ[:, -1] = True
@@ -427,8 +427,8 @@ def _random_polygons(rng, grid, k):
 def test_crowd_clearance_is_the_full_distance_transform():
     """The map's cached clearance lowered near each obstacle == the transform of the union."""
     from arena.crowd.simulator import crowd_clearance
+    from arena.maps.distance import clearance_map
     from arena.maps.raster import polygon_mask
-    from arena.tasks.sampling import clearance_map
 
     rng = np.random.default_rng(3)
     for trial in range(12):
@@ -450,7 +450,7 @@ def test_crowd_clearance_is_the_full_distance_transform():
 def test_crowd_clearance_cache_follows_the_map():
     """Another grid (other occupancy, same shape) is computed afresh, not served the old map."""
     from arena.crowd.simulator import crowd_clearance
-    from arena.tasks.sampling import clearance_map
+    from arena.maps.distance import clearance_map
 
     occ = np.zeros((40, 50), dtype=bool)
     first = OccupancyGrid.from_occupied(occ, 0.1)
@@ -464,8 +464,8 @@ def test_crowd_clearance_cache_follows_the_map():
 
 def test_simulator_reset_uses_this_episodes_obstacles():
     """Two episodes on one map with different obstacles: each gets its own clearance map."""
+    from arena.maps.distance import clearance_map
     from arena.maps.raster import polygon_mask
-    from arena.tasks.sampling import clearance_map
 
     grid = OccupancyGrid.empty(20, 20, 0.1)
     sim = CrowdSimulator(WaypointWalker(), PLAIN)

@@ -32,7 +32,7 @@ from arena.crowd.social.robots import robot_fear
 from arena.crowd.state import AgentType, CrowdState, SocialState
 from arena.crowd.walls import WallIndex, world_segments
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import Obstacle, StaticWorld
+from arena.scene.state import Obstacle, StaticWorld
 
 S = SocialState
 

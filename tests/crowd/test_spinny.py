@@ -12,7 +12,7 @@ from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
 from arena.crowd.models.pedsim import TERMS, PedsimModel
 from arena.crowd.models.spinny import SpinnyModel
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 from tests.crowd.test_pedsim import make_frame, room_walls
 
 

@@ -14,8 +14,8 @@ from arena.eval.record import EpisodeMeta
 from arena.eval.recorder import Recorder
 from arena.experiment import run_experiment
 from arena.robots.presets import load_robot
+from arena.scene.state import Obstacle
 from arena.sim.native2d import Native2DBackend
-from arena.sim.state import Obstacle
 from tests.conftest import make_episode, standing_agents
 
 SHORT = ["output.video=false", "task.timeout=5", "task.obstacles.dynamic=3", "episodes=1"]

@@ -12,7 +12,7 @@ from gymnasium.vector import AutoresetMode
 
 from arena.learn.batched import BatchedSocialNavEnv, make_generator
 from arena.learn.prefetch import EpisodePrefetcher
-from arena.tasks.episode import Episode, episode_digest
+from arena.scene.episode import Episode, episode_digest
 from tests.learn.helpers import small_cfg, small_robot
 
 

@@ -10,7 +10,7 @@ from arena.core.geometry import points_in_polygon
 from arena.maps.grid import OccupancyGrid
 from arena.maps.io import load_map
 from arena.maps.raster import burn_obstacles
-from arena.sim.state import Obstacle
+from arena.scene.state import Obstacle
 from tests.cli_kit import run_cli
 
 

@@ -9,8 +9,8 @@ from arena.core.errors import ConfigError
 from arena.core.geometry import rectangle, transform_points
 from arena.maps.grid import OccupancyGrid
 from arena.render import FrameRenderer, Overlay, style
+from arena.scene.state import AgentStates, Collisions, Obstacle, RobotStates, SimState, StaticWorld
 from arena.sensors.spec import LidarSpec
-from arena.sim.state import AgentStates, Collisions, Obstacle, RobotStates, SimState, StaticWorld
 
 RES = 0.1  # m per cell
 W_PX = 500  # 10 m wide map → 50 px/m

@@ -11,8 +11,8 @@ from arena.crowd.state import SocialState
 from arena.maps.grid import OccupancyGrid
 from arena.render import FrameRenderer, Overlay, legend_items, style
 from arena.render.legend import ELEMENTS, legend_entries
+from arena.scene.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 from arena.sensors.spec import LidarSpec
-from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 
 LONG_TITLE = "default/corridor_scenario · jackal · pysocial"
 SPEC = LidarSpec(angle_min=-np.pi, angle_max=np.pi, num_beams=90, range_max=30.0)

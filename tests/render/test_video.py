@@ -13,7 +13,7 @@ from arena.core.errors import ArenaError, ConfigError
 from arena.core.geometry import rectangle
 from arena.maps.grid import OccupancyGrid
 from arena.render import Overlay, RenderError, VideoWriter, render_episode, save_png
-from arena.sim.state import AgentStates, Collisions, Obstacle, RobotStates, SimState, StaticWorld
+from arena.scene.state import AgentStates, Collisions, Obstacle, RobotStates, SimState, StaticWorld
 
 
 def _frames(n: int, h: int = 48, w: int = 64) -> list[np.ndarray]:

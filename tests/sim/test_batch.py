@@ -9,10 +9,10 @@ import pytest
 
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
+from arena.scene.episode import Episode
 from arena.sim.batch import KIND_WALL, BatchSim
 from arena.sim.native2d import Native2DBackend
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator
 
 
@@ -110,7 +110,7 @@ def test_wall_contact_kind() -> None:
     grid = OccupancyGrid.from_occupied(np.pad(np.zeros((96, 96), bool), 2, constant_values=True),
                                        0.05)
     from arena.core.types import Pose2D
-    from arena.tasks.episode import AgentSpawn, RobotSpawn
+    from arena.scene.episode import AgentSpawn, RobotSpawn
 
     jackal = load_robot("jackal")
     ep = Episode(0, 0, "box", grid, (), (RobotSpawn("r", jackal, Pose2D(2.5, 2.5, 0.0),
@@ -203,7 +203,7 @@ def test_worlds_with_other_kinematics_regroup_on_model_change(episodes: list[Epi
 
 def test_reset_world_with_another_map_keeps_shared_map(episodes: list[Episode]) -> None:
     from arena.core.types import Pose2D
-    from arena.tasks.episode import AgentSpawn, RobotSpawn
+    from arena.scene.episode import AgentSpawn, RobotSpawn
 
     grid = OccupancyGrid.from_occupied(np.pad(np.zeros((76, 96), bool), 2, constant_values=True),
                                        0.05)
@@ -250,8 +250,8 @@ def test_worlds_mix_wall_faces_and_grid_walk() -> None:
     """A speckled map (thousands of faces: grid walk) next to rooms cast as faces, with the
     padded face table growing when a later world's map has more faces."""
     from arena.core.types import Pose2D
+    from arena.scene.episode import AgentSpawn, RobotSpawn
     from arena.sensors.lidar2d import Lidar2D, use_wall_faces, wall_faces
-    from arena.tasks.episode import AgentSpawn, RobotSpawn
 
     jackal = load_robot("jackal")
     rng = np.random.default_rng(4)
@@ -289,9 +289,9 @@ def test_obstacle_edge_forces_match_the_formula_near_and_far() -> None:
     # (the kernel skips edge runs whose bounding box is out of reach; this catches one skipped
     # wrongly). Walls, the robot and the other pedestrians are out of reach.
     from arena.core.types import Pose2D
+    from arena.scene.episode import WAYPOINT_LOOP, AgentSpawn, RobotSpawn
+    from arena.scene.state import Obstacle
     from arena.sim.batch import kernels as K
-    from arena.sim.state import Obstacle
-    from arena.tasks.episode import WAYPOINT_LOOP, AgentSpawn, RobotSpawn
 
     grid = OccupancyGrid.from_occupied(np.pad(np.zeros((396, 396), bool), 2, constant_values=True),
                                        0.05)
@@ -344,7 +344,7 @@ def test_obstacle_edge_forces_match_the_formula_near_and_far() -> None:
 def test_pedestrian_mask_follows_reloaded_worlds(episodes: list[Episode]) -> None:
     from dataclasses import replace
 
-    from arena.tasks.episode import AgentSpawn
+    from arena.scene.episode import AgentSpawn
 
     sim = BatchSim(2)
     st = sim.reset(episodes[:2], np.random.default_rng(0))

@@ -7,9 +7,9 @@ import pytest
 
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
+from arena.scene.episode import Episode
 from arena.sim.batch import BatchSim
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import Episode
 from arena.tasks.generator import TaskGenerator
 
 

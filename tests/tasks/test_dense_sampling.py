@@ -9,9 +9,9 @@ from arena.maps.grid import OccupancyGrid
 from arena.maps.io import load_map
 from arena.maps.sources import resolve_world
 from arena.robots.presets import load_robot
-from arena.sim.state import Obstacle
+from arena.scene.episode import episode_digest
+from arena.scene.state import Obstacle
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import episode_digest
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.obstacle_modes.random import RandomObstacles, obstacle_capacity
 from arena.tasks.sampling import accept_spaced

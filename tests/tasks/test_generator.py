@@ -6,9 +6,9 @@ import pytest
 from arena.core.errors import ConfigError, UnknownNameError
 from arena.core.types import Pose2D
 from arena.robots.presets import load_robot
+from arena.scene.episode import episode_digest
 from arena.tasks.base import build_mode
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import episode_digest
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.goal import goal_reached, heading_error
 

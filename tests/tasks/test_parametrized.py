@@ -3,8 +3,8 @@ import pytest
 
 from arena.core.errors import ConfigError
 from arena.robots.presets import load_robot
+from arena.scene.episode import episode_digest
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import episode_digest
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.obstacle_modes.parametrized import DEFAULT_FILE, load_parametrized
 

@@ -4,19 +4,13 @@ import numpy as np
 import pytest
 
 from arena.core.geometry import rectangle, transform_points
+from arena.maps.distance import clearance_map, grid_memo
 from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle
 from arena.maps.raster import polygon_mask
-from arena.sim.state import Obstacle
+from arena.scene.state import Obstacle
 from arena.tasks.obstacle_modes.random import walkable_mask
-from arena.tasks.sampling import (
-    MaskRegions,
-    clear_near,
-    clearance_map,
-    components,
-    grid_memo,
-    max_blocked_sq,
-)
+from arena.tasks.sampling import MaskRegions, clear_near, components, max_blocked_sq
 
 
 def _box(name, x, y, theta, size=(0.8, 0.5)):

@@ -18,7 +18,7 @@ import pytest
 from arena.core.errors import ConfigError
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
-from arena.tasks.episode import WAYPOINT_LOOP, WAYPOINT_RANDOM
+from arena.scene.episode import WAYPOINT_LOOP, WAYPOINT_RANDOM
 from arena.tasks.scenario import (
     DEFAULT_PED_RADIUS,
     DEFAULT_VMAX,

@@ -8,8 +8,8 @@ import arena
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError
 from arena.robots.presets import load_robot
+from arena.scene.episode import episode_digest
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import episode_digest
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.suite import arena_stage_seed, load_benchmark, load_contest, load_suite
 

@@ -6,8 +6,8 @@ from arena.core.geometry import points_in_polygon
 from arena.maps.io import load_map
 from arena.maps.sources import WORLDS_DIR, resolve_world
 from arena.robots.presets import load_robot
+from arena.scene.episode import episode_digest
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import episode_digest
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.robot_modes.zones import ZoneRobots
 from arena.tasks.world import WorldSampler

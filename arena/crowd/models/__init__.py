@@ -1,13 +1,5 @@
-"""The built-in crowd models; importing this package registers them all."""
+"""The built-in crowd models, one module each (each registers its models on import).
 
-from arena.crowd.models import (  # noqa: F401  (each module registers its models)
-    bonding,
-    deep_social_force,
-    evacuation,
-    orca,
-    pedsim,
-    pysocial,
-    rvo2,
-    spinny,
-    walker,
-)
+:data:`~arena.crowd.base.CROWD_MODELS` declares them by name and imports a module when a config
+first names one of its models.
+"""

@@ -38,8 +38,10 @@ from arena.crowd.models.orca import (
     OrcaParams,
     preferred_velocities,
 )
+from arena.crowd.simulator import episode_segments
 from arena.crowd.state import CrowdState
-from arena.sim.state import StaticWorld
+from arena.crowd.walls import grid_walls
+from arena.scene.state import StaticWorld
 
 __all__ = ["Obstacles", "Rvo2Model", "Rvo2Params", "preferred_velocities", "world_polygons"]
 
@@ -71,8 +73,6 @@ def world_polygons(world: StaticWorld) -> list[FloatArray]:
         obstacle of ``world.obstacles``, in order: what :meth:`Obstacles.from_polygons` (RVO2's
         ``addObstacle`` for each) takes.
     """
-    from arena.crowd.simulator import grid_walls  # (cached; the simulator imports the models)
-
     ga, gb = grid_walls(world.grid)
     keep = np.any(ga != gb, axis=1)
     polys: list[FloatArray] = list(np.stack([ga[keep], gb[keep]], axis=1))
@@ -112,8 +112,6 @@ class Rvo2Model(OrcaModel):
         (:func:`world_polygons`); frames whose walls are the world's segments
         (:func:`~arena.crowd.walls.world_segments`, as the simulator passes them) use them.
         """
-        from arena.crowd.simulator import episode_segments
-
         a, b = episode_segments(world)
         self._convert(a, b, state, world_polygons(world))
 

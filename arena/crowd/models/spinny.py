@@ -22,7 +22,7 @@ from pydantic import Field
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.models.pedsim import PedsimModel
 from arena.crowd.state import CrowdState
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 

@@ -16,7 +16,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.state import CrowdState
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 
 @CROWD_MODELS.register("waypoint_walker", tags=("baseline",))

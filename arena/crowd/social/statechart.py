@@ -55,9 +55,9 @@ from arena.crowd.social.perception import NEAR_FACTOR, Vision, wall_index_arrays
 from arena.crowd.social.robots import robot_avoidance as _avoidance
 from arena.crowd.social.robots import robot_fear
 from arena.crowd.state import AgentType, CrowdState, SocialState
-from arena.crowd.walls import WallIndex
+from arena.crowd.walls import WallIndex, grid_walls
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -122,11 +122,9 @@ def _grid_wall_index(grid: OccupancyGrid) -> WallIndex | None:
     """The wall index of ``grid`` (``None`` without walls), reused while the map stays the same.
 
     An RL env builds a fresh crowd (so a fresh :class:`SocialStates`) every reset, mostly on
-    the same map; :func:`~arena.crowd.simulator.grid_walls` returns the same segment arrays
+    the same map; :func:`~arena.crowd.walls.grid_walls` returns the same segment arrays
     while the map is unchanged, and a :class:`WallIndex` is read-only once built.
     """
-    from arena.crowd.simulator import grid_walls  # the simulator imports this module lazily
-
     wa, wb = grid_walls(grid)
     if _WALL_CACHE and _WALL_CACHE[0][0] is wa:
         return _WALL_CACHE[0][1]

@@ -34,7 +34,7 @@ from arena.maps.generators.base import register_generator
 from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle, obstacle_model
 from arena.maps.sources import GridSizeParams, MapResult
-from arena.sim.state import Obstacle
+from arena.scene.state import Obstacle
 
 Placement = tuple[str, float, float, float]
 """One obstacle of a placement: ``(model, x, y, yaw)`` in metres / radians."""

@@ -53,11 +53,11 @@ from arena.core.errors import SimulationError
 from arena.maps.grid import OccupancyGrid
 from arena.robots.kinematics.base import Kinematics, KinematicState
 from arena.robots.model import RobotModel
+from arena.scene.episode import Episode
 from arena.sensors.lidar2d import _add_noise, use_wall_faces, wall_faces
 from arena.sensors.spec import LidarSpec
 from arena.sim.backend import split_rng
 from arena.sim.batch import kernels as K
-from arena.tasks.episode import Episode
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]

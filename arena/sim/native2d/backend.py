@@ -20,6 +20,8 @@ from pydantic import BaseModel, ConfigDict, Field
 from arena.core.errors import SimulationError
 from arena.core.types import Pose2D
 from arena.robots.kinematics.base import KinematicState, box_step_row
+from arena.scene.episode import Episode
+from arena.scene.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
 from arena.sensors.lidar2d import Lidar2D
 from arena.sim.backend import BACKENDS, PedestrianDriver, split_rng
 from arena.sim.native2d.collisions import (
@@ -30,8 +32,6 @@ from arena.sim.native2d.collisions import (
     footprints_overlap,
     hits_grid,
 )
-from arena.sim.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
-from arena.tasks.episode import Episode
 
 
 @BACKENDS.register("native2d", tags=("default",))

@@ -24,7 +24,7 @@ from arena.core.geometry import (
     transform_points,
 )
 from arena.maps.grid import OccupancyGrid
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 SQRT2 = math.sqrt(2.0)
 

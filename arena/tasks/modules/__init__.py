@@ -1,9 +1,5 @@
-"""Task modules (``task.modules``): hooks around each reset (curricula, maps, benchmarks, UI)."""
+"""Task modules (``task.modules``): hooks around each reset (curricula, maps, benchmarks, UI).
 
-from arena.tasks.modules import (  # noqa: F401
-    benchmark,
-    clear_forbidden_zones,
-    dynamic_map,
-    interactive,
-    staged,
-)
+Each module registers its mode on import; :data:`~arena.tasks.base.TASK_MODES` declares them
+by name and imports one when a config first names it.
+"""

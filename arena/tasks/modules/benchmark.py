@@ -18,9 +18,11 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.config.schema import ExperimentConfig
 from arena.robots.model import RobotModel
+from arena.robots.presets import load_robot
+from arena.scene.episode import Episode
 from arena.tasks.base import ModuleBase, ResetContext, build_mode, register_mode
 from arena.tasks.config import TaskConfig
-from arena.tasks.episode import Episode
+from arena.tasks.obstacle_modes.random import RandomObstacles
 from arena.tasks.suite import Suite, load_suite
 
 
@@ -114,8 +116,6 @@ class Benchmark(ModuleBase):
             self.suite.stage_experiments(base),
             strict=True,
         ))
-        from arena.robots.presets import load_robot
-
         src = self.suite.source
         for i, (st, cfg) in exps.items():
             self._stages[(i, ctx.seed)] = _Stage(
@@ -135,8 +135,6 @@ class Benchmark(ModuleBase):
     @staticmethod
     def _base_config(ctx: ResetContext) -> ExperimentConfig:
         """The run's settings that a stage does not override, read from the context."""
-        from arena.tasks.obstacle_modes.random import RandomObstacles
-
         task: dict[str, Any] = {
             "timeout": ctx.timeout,
             "goal_radius": ctx.goal_radius,

@@ -35,8 +35,8 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from arena.core.errors import ArenaError, ConfigError
 from arena.core.types import Pose2D
+from arena.scene.episode import Episode
 from arena.tasks.base import ModuleBase, ResetContext, register_mode
-from arena.tasks.episode import Episode
 from arena.tasks.world import WorldSampler
 
 CommandKind = Literal["teleport", "goal", "reset"]

@@ -1,3 +1,5 @@
-"""Obstacle task modes (``task.obstacles``): static obstacles and pedestrians of an episode."""
+"""Obstacle task modes (``task.obstacles``): static obstacles and pedestrians of an episode.
 
-from arena.tasks.obstacle_modes import parametrized, random, scenario, zones  # noqa: F401
+Each module registers its mode on import; :data:`~arena.tasks.base.TASK_MODES` declares them
+by name and imports one when a config first names it.
+"""

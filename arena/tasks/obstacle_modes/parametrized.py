@@ -39,9 +39,9 @@ from pydantic import Field
 
 from arena.core.errors import ConfigError
 from arena.maps.obstacles import obstacle_models
-from arena.sim.state import Obstacle
+from arena.scene.episode import MAX_COUNT, AgentSpawn
+from arena.scene.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import MAX_COUNT, AgentSpawn
 from arena.tasks.obstacle_modes.random import (
     BOX,
     PlacementParams,

@@ -25,26 +25,21 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from arena.core.errors import SamplingError
 from arena.core.geometry import point_segment_distance, points_in_polygon, rectangle
+from arena.maps.distance import clearance_map, grid_memo
 from arena.maps.grid import OccupancyGrid
 from arena.maps.obstacles import make_obstacle, obstacle_models
 from arena.maps.raster import polygon_mask, polygon_window
-from arena.sim.state import Obstacle
-from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import (
+from arena.scene.episode import (
     MAX_COUNT,
     MAX_PERSON_SPEED,
     WAYPOINT_LOOP,
     AgentSpawn,
     speed_range_problem,
 )
+from arena.scene.state import Obstacle
+from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.robot_modes.random import spawn_radius
-from arena.tasks.sampling import (
-    MaskRegions,
-    clear_near,
-    clearance_map,
-    grid_memo,
-    max_blocked_sq,
-)
+from arena.tasks.sampling import MaskRegions, clear_near, max_blocked_sq
 from arena.tasks.world import wall_distance_map
 
 BOX = "box"
@@ -409,8 +404,8 @@ def walkable_mask(
     """``(H, W)`` bool: free cells whose centre is more than ``body`` (m) from every blocked cell.
 
     Blocked are the map's non-free cells and the cells under any obstacle footprint;
-    distances are :func:`~arena.tasks.sampling.clearance_map`'s. The map's own part is
-    computed once per map (:func:`~arena.tasks.sampling.grid_memo`); this episode's obstacles
+    distances are :func:`~arena.maps.distance.clearance_map`'s. The map's own part is
+    computed once per map (:func:`~arena.maps.distance.grid_memo`); this episode's obstacles
     then only clear the cells near them, which gives the same mask as thresholding the
     clearance map of all blocked cells (distances to a union are the minimum of the parts').
     """

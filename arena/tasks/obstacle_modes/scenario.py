@@ -9,9 +9,9 @@ from __future__ import annotations
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import ConfigError
-from arena.sim.state import Obstacle
+from arena.scene.episode import AgentSpawn
+from arena.scene.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import AgentSpawn
 from arena.tasks.robot_modes.scenario import ScenarioFile, ScenarioRobots
 from arena.tasks.scenario import scenario_agents, scenario_obstacles
 from arena.tasks.scenario_checks import check_robot_bodies

@@ -22,9 +22,9 @@ from __future__ import annotations
 import numpy as np
 from pydantic import Field, model_validator
 
-from arena.sim.state import Obstacle
+from arena.scene.episode import MAX_PERSON_SPEED, WAYPOINT_LOOP, AgentSpawn, speed_range_problem
+from arena.scene.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import MAX_PERSON_SPEED, WAYPOINT_LOOP, AgentSpawn, speed_range_problem
 from arena.tasks.robot_modes.random import spawn_radius
 from arena.tasks.zones import ZoneFileParams, ZoneFiles, sample_in_zones
 

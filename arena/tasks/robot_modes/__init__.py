@@ -1,3 +1,5 @@
-"""Robot task modes (``task.robots``): where robots start and which goals they get."""
+"""Robot task modes (``task.robots``): where robots start and which goals they get.
 
-from arena.tasks.robot_modes import explore, guided, random, scenario, zones  # noqa: F401
+Each module registers its mode on import; :data:`~arena.tasks.base.TASK_MODES` declares them
+by name and imports one when a config first names it.
+"""

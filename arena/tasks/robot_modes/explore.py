@@ -16,8 +16,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import SamplingError
 from arena.core.types import Pose2D
+from arena.scene.episode import RobotSpawn
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import RobotSpawn
 from arena.tasks.robot_modes.random import random_spawns, spawn_radius
 from arena.tasks.sampling import components
 from arena.tasks.world import WorldSampler

@@ -17,8 +17,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import ConfigError
 from arena.core.types import Pose2D
+from arena.scene.episode import RobotSpawn
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import RobotSpawn
 from arena.tasks.robot_modes.random import robot_name, sample_pose, spawn_radius
 
 

@@ -24,10 +24,11 @@ from scipy.spatial import ConvexHull, QhullError
 
 from arena.core.errors import SamplingError
 from arena.core.types import Pose2D
+from arena.maps.distance import grid_memo
 from arena.robots.model import RobotModel
+from arena.scene.episode import RobotSpawn
 from arena.tasks.base import ResetContext, SingleGoal, register_mode
-from arena.tasks.episode import RobotSpawn
-from arena.tasks.sampling import components, grid_memo
+from arena.tasks.sampling import components
 from arena.tasks.world import WorldSampler
 
 

@@ -12,8 +12,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import ConfigError
 from arena.core.types import Pose2D
+from arena.scene.episode import RobotSpawn
 from arena.tasks.base import ResetContext, SingleGoal, register_mode
-from arena.tasks.episode import RobotSpawn
 from arena.tasks.robot_modes.random import robot_name, spawn_radius
 from arena.tasks.scenario import Scenario, load_scenario
 from arena.tasks.scenario_checks import check_layout, check_robot_bodies, validate_against_map

@@ -17,8 +17,8 @@ from pydantic import Field
 
 from arena.core.errors import ConfigError, SamplingError
 from arena.core.types import Pose2D
+from arena.scene.episode import RobotSpawn
 from arena.tasks.base import ResetContext, register_mode
-from arena.tasks.episode import RobotSpawn
 from arena.tasks.robot_modes.random import robot_name, spawn_radius
 from arena.tasks.sampling import components
 from arena.tasks.world import WorldSampler

@@ -93,7 +93,7 @@ from arena.crowd.walls import WallIndex, world_segments
 
 if TYPE_CHECKING:
     from arena.crowd.state import CrowdState
-    from arena.sim.state import StaticWorld
+    from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

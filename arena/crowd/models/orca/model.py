@@ -44,7 +44,7 @@ from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.models.orca.kernels import orca_kernel
 from arena.crowd.models.orca.obstacles import Obstacles
 from arena.crowd.state import CrowdState
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.floating]
 IntArray = NDArray[np.int64]

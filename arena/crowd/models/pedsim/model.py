@@ -68,7 +68,7 @@ from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.models.pedsim.kernels import _agent_terms, _social_terms
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import WallIndex, world_segments
-from arena.sim.state import StaticWorld
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]

@@ -143,7 +143,9 @@ from arena.crowd.models.pysocial.pair_kernels import (
 )
 from arena.crowd.neighbors import CellList
 from arena.crowd.state import CrowdState
-from arena.sim.state import StaticWorld
+from arena.crowd.walls import grid_walls
+from arena.maps.distance import grid_memo
+from arena.scene.state import StaticWorld
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -277,9 +279,6 @@ class PySocialModel:
 
     def reset(self, state: CrowdState, world: StaticWorld, rng: np.random.Generator) -> None:
         """Sample the episode's walls and obstacle edges into points, once."""
-        from arena.crowd.simulator import grid_walls
-        from arena.tasks.sampling import grid_memo
-
         res = self.params.resolution
 
         def wall_points() -> FloatArray:

@@ -1,4 +1,4 @@
-"""Snapshots of the simulated world, as structs of arrays.
+"""Placed obstacles, the static world and snapshots of the simulated world (structs of arrays).
 
 A :class:`SimState` is returned by every ``reset``/``step`` of a backend. Its arrays are copies
 that the backend never mutates afterwards, so a recorder may keep them.
@@ -7,12 +7,15 @@ that the backend never mutates afterwards, so a recorder may keep them.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from arena.core.geometry import transform_points
-from arena.maps.grid import OccupancyGrid
+
+if TYPE_CHECKING:  # the scene only holds a grid; maps sits above it (maps makes Obstacles)
+    from arena.maps.grid import OccupancyGrid
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]

@@ -8,14 +8,17 @@ from __future__ import annotations
 
 import hashlib
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from arena.core.types import Pose2D
-from arena.maps.grid import OccupancyGrid
-from arena.robots.model import RobotModel
-from arena.sim.state import Obstacle
+from arena.scene.state import Obstacle
+
+if TYPE_CHECKING:  # held, never called: the scene layer sits below maps and robots
+    from arena.maps.grid import OccupancyGrid
+    from arena.robots.model import RobotModel
 
 WAYPOINT_LOOP = 0
 """Arena's ``waypoint_mode`` 0: visit the waypoints in order, then start again."""
