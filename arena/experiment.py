@@ -41,6 +41,7 @@ import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ArenaError, PlanningError
 from arena.core.files import make_dir
+from arena.core.geometry import segment_lengths
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
@@ -48,7 +49,7 @@ from arena.eval.counterfactual import align, replay_crowd
 from arena.eval.io import save_record
 from arena.eval.record import EpisodeMeta, EpisodeRecord
 from arena.eval.recorder import Recorder
-from arena.maps.raster import burn_obstacles
+from arena.maps.raster import planning_grid
 from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack, NavStatus
@@ -146,11 +147,6 @@ def make_episode(
         cfg, [robot] if robot is not None else None
     )
     return generator.episode(index)
-
-
-def planning_grid(episode: Episode):
-    """The map with the known static obstacles burnt in: what the global planner plans on."""
-    return burn_obstacles(episode.grid, episode.obstacles)
 
 
 class EpisodeRecorder:
@@ -428,7 +424,7 @@ def run_episode(
             record, ped_cf_position=align(record.ped_row, record.ped_id, track)
         )
     poses = recorder.poses
-    steps = np.hypot(*np.diff(poses[:, :2], axis=0).T) if len(poses) > 1 else np.zeros(0)
+    steps = segment_lengths(poses)
     for row in jumps:  # a teleport is no distance driven
         if 0 < row <= len(steps):
             steps[row - 1] = 0.0

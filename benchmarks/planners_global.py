@@ -16,10 +16,11 @@ import time
 
 import numpy as np
 
+from arena.core.geometry import polyline_length
 from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
 from arena.nav.costmap import GlobalCostmap, LocalCostmap
-from arena.nav.global_planners import GLOBAL_PLANNERS, path_length
+from arena.nav.global_planners import GLOBAL_PLANNERS
 
 RES = 0.05
 SEED = 0
@@ -63,7 +64,7 @@ def main() -> None:
                     lambda p=planner, g=grid, s=start, t=goal: p.plan(g, s, t), args.repeats
                 )
                 path = planner.plan(grid, start, goal)
-                print(f"  {label:<26}{name:<12}{ms:>10.1f}{path_length(path):>11.2f}"
+                print(f"  {label:<26}{name:<12}{ms:>10.1f}{polyline_length(path):>11.2f}"
                       f"{len(path):>11d}")
 
     print("Costmaps: ms per update")

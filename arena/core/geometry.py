@@ -59,6 +59,28 @@ def regular_polygon(radius: float, sides: int = 16) -> FloatArray:
     return np.stack([radius * np.cos(t), radius * np.sin(t)], axis=-1)
 
 
+def segment_lengths(points: ArrayLike) -> FloatArray:
+    """``(k−1,)`` m, the 2-D lengths of the segments of the polyline ``points``.
+
+    ``points``: ``(k, ≥2)`` m (columns x, y, anything after them, e.g. a heading, is ignored);
+    empty for ``k < 2``. ``np.hypot`` per segment, so every path length in Arena rounds alike.
+    """
+    p = np.asarray(points, dtype=np.float64)
+    if len(p) < 2:
+        return np.zeros(0)
+    d = np.diff(p[:, :2], axis=0)
+    return np.asarray(np.hypot(d[:, 0], d[:, 1]), dtype=np.float64)
+
+
+def polyline_length(points: ArrayLike) -> float:
+    """m, the 2-D length of the polyline ``points`` ``(k, ≥2)`` (0 for ``k < 2``).
+
+    The sum of :func:`segment_lengths`: the length of a planned path, a driven trajectory or a
+    band.
+    """
+    return float(np.sum(segment_lengths(points)))
+
+
 def polygon_area(polygon: ArrayLike) -> float:
     """Signed area (m²): positive for counter-clockwise vertex order."""
     p = np.asarray(polygon, dtype=np.float64)

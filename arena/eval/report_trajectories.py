@@ -38,7 +38,7 @@ def episode_grid(record: EpisodeRecord) -> Any:
     """
     from arena.config.schema import ExperimentConfig
     from arena.core.errors import ArenaError
-    from arena.experiment import planning_grid
+    from arena.maps.raster import planning_grid
     from arena.tasks.generator import TaskGenerator
 
     if not record.meta.config:

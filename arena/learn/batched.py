@@ -53,7 +53,6 @@ from arena.learn.actions import ActionDecoder
 from arena.learn.driver import (
     ConfigLike,
     SubgoalTracker,
-    planning_grid,
     resolve_config,
     substeps,
 )
@@ -61,6 +60,7 @@ from arena.learn.keywords import check_config_keywords
 from arena.learn.observations import Obs, ObservationBuilder, ObsInput
 from arena.learn.prefetch import EpisodePrefetcher
 from arena.learn.rewards import DoneReason, RewardFunction, RewardInput, RewardOutput
+from arena.maps.raster import planning_grid
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.scene.episode import Episode

@@ -40,7 +40,7 @@ from arena.learn.rewards import (
     RewardOutput,
     SingleRewardInput,
 )
-from arena.maps.raster import polygon_mask
+from arena.maps.raster import planning_grid
 from arena.nav.global_planners.astar import AStarPlanner
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
@@ -117,15 +117,6 @@ _COLLISION = int(DoneReason.COLLISION)
 _OUT_SUCCESS = Outcome.SUCCESS.value
 _OUT_COLLISION = Outcome.COLLISION.value
 _OUT_TIMEOUT = Outcome.TIMEOUT.value
-
-
-def planning_grid(episode: Episode) -> Any:
-    """The map with the known static obstacles burnt in (:func:`arena.experiment.planning_grid`)."""
-    if not episode.obstacles:
-        return episode.grid
-    return episode.grid.with_occupied(
-        polygon_mask(episode.grid, [o.polygon for o in episode.obstacles])
-    )
 
 
 class SubgoalTracker:

@@ -8,7 +8,7 @@ import threading
 import weakref
 from collections import OrderedDict
 from collections.abc import Callable, Hashable, Sequence
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 from numba import njit
@@ -16,6 +16,9 @@ from numpy.typing import NDArray
 
 from arena.core.geometry import convex_polygon_overlaps_squares, points_in_polygon
 from arena.maps.grid import OccupancyGrid
+
+if TYPE_CHECKING:
+    from arena.scene.episode import Episode
 
 T = TypeVar("T")
 
@@ -107,6 +110,15 @@ def burn_obstacles(grid: OccupancyGrid, obstacles: Sequence[Any]) -> OccupancyGr
     if not obstacles:
         return grid
     return grid.with_occupied(polygon_mask(grid, [o.polygon for o in obstacles]))
+
+
+def planning_grid(episode: Episode) -> OccupancyGrid:
+    """The episode's map with its known static obstacles burnt in: what the global planner plans on.
+
+    One definition for every episode loop (``arena run``, the learning envs, value training) and
+    the trajectory report, so all of them plan on the same grid.
+    """
+    return burn_obstacles(episode.grid, episode.obstacles)
 
 
 def polygon_window(

@@ -161,3 +161,17 @@ def test_convex_polygon_overlaps_squares_matches_vectorised_reference(seed):
         got = g.convex_polygon_overlaps_squares(poly, centers, half)
         want = _reference_squares(poly, centers, half)
         assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
+def test_polyline_length_reference_values_and_columns():
+    # a 3-4-5 leg then 1 m along x: 5 + 1 m; a heading column is ignored
+    pts = np.array([[0.0, 0.0, 0.3], [3.0, 4.0, -1.0], [4.0, 4.0, 2.0]])
+    np.testing.assert_array_equal(g.segment_lengths(pts), [5.0, 1.0])
+    assert g.polyline_length(pts) == 6.0
+    assert g.polyline_length(pts[:, :2].tolist()) == 6.0
+    # fewer than two points: no segment, length 0
+    assert g.segment_lengths(pts[:1]).shape == (0,)
+    assert g.polyline_length(np.zeros((0, 2))) == 0.0
+    # hypot per segment, so the length is the same number the driven-path metrics report
+    d = np.random.default_rng(3).normal(size=(50, 2)).cumsum(axis=0)
+    np.testing.assert_array_equal(g.segment_lengths(d), np.hypot(*np.diff(d, axis=0).T))

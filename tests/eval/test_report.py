@@ -96,7 +96,8 @@ def test_trajectory_maps_are_rebuilt_from_the_records(tmp_path):
     from arena.config.loader import load_config
     from arena.eval.io import load_record
     from arena.eval.report_trajectories import episode_grid, stage_trajectories
-    from arena.experiment import planning_grid, run_experiment
+    from arena.experiment import run_experiment
+    from arena.maps.raster import planning_grid
     from arena.tasks.generator import TaskGenerator
 
     def records(extra, name):

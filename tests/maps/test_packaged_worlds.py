@@ -45,7 +45,7 @@ def test_world_scenario_is_valid_and_walkable(name):
         for p, q in legs:
             assert line_of_sight(grid, clear, p, q), f"{name}: agent {i} leg {p} -> {q} blocked"
     # The robot's goal is reachable.
-    from arena.experiment import planning_grid
+    from arena.maps.raster import planning_grid
     from arena.nav.global_planners.astar import AStarPlanner
 
     r = ep.robots[0]

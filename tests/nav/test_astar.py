@@ -11,9 +11,10 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from arena.core.errors import ConfigError, GoalOccupied, NoPathFound, StartOccupied
+from arena.core.geometry import polyline_length
 from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
-from arena.nav.global_planners import GLOBAL_PLANNERS, AStarPlanner, path_length
+from arena.nav.global_planners import GLOBAL_PLANNERS, AStarPlanner
 
 RES = 0.1
 
@@ -77,7 +78,7 @@ def test_cost_equals_dijkstra(seed: int) -> None:
             planner.plan(grid, _centre(grid, s), _centre(grid, g))
         return
     path = planner.plan(grid, _centre(grid, s), _centre(grid, g))
-    assert path_length(path) == pytest.approx(best, rel=1e-9, abs=1e-9)
+    assert polyline_length(path) == pytest.approx(best, rel=1e-9, abs=1e-9)
     cells = _cells_of(grid, path)
     assert not occ[cells[:, 0], cells[:, 1]].any()
     steps = np.abs(np.diff(cells, axis=0))
@@ -122,10 +123,10 @@ def test_clearance_keeps_path_off_walls() -> None:
 def test_weighted_heuristic_is_bounded_suboptimal() -> None:
     occ, s, g = _random_grid(1, shape=(40, 40), density=0.25)  # a connected sample
     grid = OccupancyGrid.from_occupied(occ, RES)
-    opt = path_length(_planner(clearance_weight=0, smooth=False).plan(
+    opt = polyline_length(_planner(clearance_weight=0, smooth=False).plan(
         grid, _centre(grid, s), _centre(grid, g)))
     w = 1.8
-    sub = path_length(_planner(clearance_weight=0, smooth=False, heuristic_weight=w).plan(
+    sub = polyline_length(_planner(clearance_weight=0, smooth=False, heuristic_weight=w).plan(
         grid, _centre(grid, s), _centre(grid, g)))
     assert opt - 1e-9 <= sub <= w * opt + 1e-9
 
@@ -137,7 +138,7 @@ def test_four_connected_moves_only_orthogonally() -> None:
     )
     steps = np.abs(np.diff(grid.world_to_cell(path), axis=0)).sum(axis=1)
     assert np.all(steps == 1)
-    assert path_length(path) == pytest.approx(RES * (18 + 23))
+    assert polyline_length(path) == pytest.approx(RES * (18 + 23))
 
 
 def _segment_cells(grid: OccupancyGrid, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -162,7 +163,7 @@ def test_smoothing_never_crosses_occupied_cells(seed: int) -> None:
         return
     smooth = _planner(smooth=True).plan(grid, start, goal)
     assert len(smooth) <= len(raw)
-    assert path_length(smooth) <= path_length(raw) + 1e-9
+    assert polyline_length(smooth) <= polyline_length(raw) + 1e-9
     np.testing.assert_allclose(smooth[0], start.xy)
     np.testing.assert_allclose(smooth[-1], goal.xy)
     for a, b in itertools.pairwise(smooth):

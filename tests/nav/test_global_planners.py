@@ -11,6 +11,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
 from arena.core.errors import GoalOccupied, NoPathFound, StartOccupied
+from arena.core.geometry import polyline_length
 from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
 from arena.nav.costmap import INSCRIBED, LETHAL, Costmap
@@ -18,7 +19,6 @@ from arena.nav.global_planners import (
     GLOBAL_PLANNERS,
     DijkstraPlanner,
     ThetaStarPlanner,
-    path_length,
     plan_on_costmap,
     segment_is_free,
 )
@@ -93,7 +93,7 @@ def test_astar_and_dijkstra_equal_brute_force(seed: int) -> None:
                 planner.plan(grid, _centre(grid, s), _centre(grid, g))
             continue
         path = planner.plan(grid, _centre(grid, s), _centre(grid, g))
-        assert path_length(path) == pytest.approx(best, rel=1e-9, abs=1e-9), name
+        assert polyline_length(path) == pytest.approx(best, rel=1e-9, abs=1e-9), name
 
 
 @pytest.mark.parametrize("seed", range(30))
@@ -108,7 +108,7 @@ def test_theta_star_no_longer_than_astar_and_line_of_sight(seed: int) -> None:
             _exact("theta_star").plan(grid, start, goal)
         return
     path = _exact("theta_star").plan(grid, start, goal)
-    assert path_length(path) <= path_length(grid_path) + 1e-9
+    assert polyline_length(path) <= polyline_length(grid_path) + 1e-9
     np.testing.assert_allclose(path[0], start.xy)
     np.testing.assert_allclose(path[-1], goal.xy)
     for a, b in itertools.pairwise(path):
@@ -141,8 +141,8 @@ def test_theta_star_is_strictly_shorter_on_open_diagonal() -> None:
     astar = _exact("astar").plan(grid, start, goal)
     straight = math.hypot(goal.x - start.x, goal.y - start.y)
     assert len(theta) == 2
-    assert path_length(theta) == pytest.approx(straight)
-    assert path_length(theta) < path_length(astar) - 0.1
+    assert polyline_length(theta) == pytest.approx(straight)
+    assert polyline_length(theta) < polyline_length(astar) - 0.1
 
 
 def test_theta_star_bends_at_a_wall() -> None:
@@ -164,7 +164,7 @@ def test_dijkstra_smoothing_and_clearance_defaults_give_free_path() -> None:
         assert segment_is_free(grid, a, b)
     # Same search cost as A* (whose default shares the edge cost), so the same smoothed path.
     astar = GLOBAL_PLANNERS.build({"type": "astar"}).plan(grid, _centre(grid, s), _centre(grid, g))
-    assert path_length(path) == pytest.approx(path_length(astar), rel=1e-6)
+    assert polyline_length(path) == pytest.approx(polyline_length(astar), rel=1e-6)
 
 
 @pytest.mark.parametrize("name", ["dijkstra", "theta_star"])
@@ -250,7 +250,7 @@ def test_costmap_planning_detours_around_costly_band() -> None:
     assert careful[:, 1].min() < 0.5  # through the gap below the band
     smooth = plan_on_costmap(cm, start, goal, cost_weight=50.0, smooth=True)
     assert len(smooth) < len(careful)
-    assert path_length(smooth) <= path_length(careful) + 1e-9
+    assert polyline_length(smooth) <= polyline_length(careful) + 1e-9
     with pytest.raises(StartOccupied):
         plan_on_costmap(cm, Pose2D(3.05, 1.55), goal, lethal_threshold=250)
     with pytest.raises(ValueError, match="cost_weight"):

@@ -55,7 +55,7 @@ def test_constraints_hold(seed):
         assert first_obstacle_hit(idx, fp, pose) == -1
         assert exact.clearance(pose[None, :2])[0] >= jackal.radius + 0.25
     assert r.start.distance_to(r.goal) >= 8.0
-    from arena.experiment import planning_grid
+    from arena.maps.raster import planning_grid
 
     path = AStarPlanner().plan(planning_grid(ep).inflate(jackal.radius), r.start, r.goal)
     assert len(path) >= 2

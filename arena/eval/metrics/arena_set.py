@@ -25,6 +25,7 @@ import math
 
 import numpy as np
 
+from arena.core import geometry
 from arena.eval.metrics.base import (
     BoolArray,
     FloatArray,
@@ -57,8 +58,7 @@ def reached_goal(record: EpisodeRecord, params: MetricParams) -> bool:
 
 def segment_lengths(record: EpisodeRecord) -> FloatArray:
     """``(T−1,)`` m, 2-D lengths of consecutive position pairs (teleport jumps included)."""
-    d = np.diff(record.pose[:, :2], axis=0)
-    return np.hypot(d[:, 0], d[:, 1])
+    return geometry.segment_lengths(record.pose)
 
 
 def _triples(record: EpisodeRecord) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:

@@ -67,7 +67,6 @@ from arena.config.schema import ExperimentConfig
 from arena.core.errors import ArenaError, PlanningError
 from arena.core.rng import derive_rng
 from arena.crowd.simulator import CrowdSimulator
-from arena.experiment import planning_grid
 from arena.learn.value.network import (
     CADRL_LAYOUT,
     SARL_LAYOUT,
@@ -78,6 +77,7 @@ from arena.learn.value.network import (
     save_value_policy,
 )
 from arena.learn.value.state import PAIR_DIM, SELF_DIM, rotate
+from arena.maps.raster import planning_grid
 from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import KINEMATICS, LOCAL_PLANNERS, LocalObservation, LocalPlanner
 from arena.nav.local_planners.crowdnav import (

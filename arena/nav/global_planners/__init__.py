@@ -12,7 +12,6 @@ from arena.nav.global_planners.base import (
     GLOBAL_PLANNERS,
     GlobalPlanner,
     endpoint_cells,
-    path_length,
 )
 from arena.nav.global_planners.dijkstra import DijkstraPlanner, plan_on_costmap
 from arena.nav.global_planners.theta_star import ThetaStarPlanner
@@ -24,7 +23,6 @@ __all__ = [
     "GlobalPlanner",
     "ThetaStarPlanner",
     "endpoint_cells",
-    "path_length",
     "plan_on_costmap",
     "segment_is_free",
 ]

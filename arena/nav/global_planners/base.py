@@ -88,11 +88,3 @@ def endpoint_cells(
             )
         cells.append((r, c))
     return cells[0], cells[1]
-
-
-def path_length(path: NDArray[np.float64]) -> float:
-    """Length (m) of a ``(k, 2)`` polyline."""
-    p = np.asarray(path, dtype=np.float64)
-    if len(p) < 2:
-        return 0.0
-    return float(np.sum(np.linalg.norm(np.diff(p, axis=0), axis=1)))

@@ -63,6 +63,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from scipy.optimize import least_squares
 from scipy.sparse import coo_matrix
 
+from arena.core.geometry import polyline_length, segment_lengths
 from arena.core.types import wrap_angle_scalar
 from arena.nav.local_planners.base import (
     KINEMATICS,
@@ -545,7 +546,7 @@ class TEBPlanner:
                 if dl is not None and float(np.min(dl)) < 0.5:
                     j = int(np.argmin(dl))
                     pts = np.vstack([pose[None, :2], rest, local[j + 1:]])
-        length = float(np.sum(np.linalg.norm(np.diff(pts, axis=0), axis=1)))
+        length = polyline_length(pts)
         n = int(np.clip(round(length / p.segment), p.min_poses, p.max_poses))
         xy, _ = _resample(pts, n + 1)
         xy[-1] = local[-1]
@@ -623,7 +624,7 @@ class TEBPlanner:
             n=n, start=pose.copy(), end=band.poses[-1, :2].copy(), twist=twist, final=final,
             drive=drive, limits=lim, radius=float(obs.robot_radius), obstacles=obstacles,
             obstacle_idx=np.zeros((n - 1, 0), dtype=np.int64),
-            max_segment=1.5 * float(np.max(np.hypot(*np.diff(band.poses[:, :2], axis=0).T))),
+            max_segment=1.5 * float(np.max(segment_lengths(band.poses))),
             path=local, times=band.times, peds=peds,
             ped_pred=self._predict(peds, band.times),
         )
@@ -718,7 +719,7 @@ class TEBPlanner:
                     return finish_command(back, twist, lim, dt, car)
             if not car and not holo and scale < 0.5:
                 # Blocked straight ahead: turn toward where the band goes further on.
-                ahead = np.cumsum(np.hypot(*np.diff(band.poses[:, :2], axis=0).T))
+                ahead = np.cumsum(segment_lengths(band.poses))
                 j = min(int(np.searchsorted(ahead, p.lookahead)) + 1, len(band.poses) - 1)
                 far = band.poses[j, :2] - pose[:2]
                 err = wrap_angle_scalar(math.atan2(far[1], far[0]) - float(pose[2]))
