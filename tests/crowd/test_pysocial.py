@@ -1,4 +1,8 @@
-"""``pysocial``: every force term against PyPI ``pysocialforce`` 1.1.2, plus behaviour tests.
+"""``pysocial`` against references: PyPI ``pysocialforce`` 1.1.2 and the plain formulations.
+
+Every force term is checked against ``pysocialforce``, the compiled kernels against their plain
+NumPy / Python formulations (to the bit); the behaviour tests are in
+``test_pysocial_behaviour.py``.
 
 The reference tests need the package (``pip install pysocialforce==1.1.2``, in the ``test``
 extra) and skip without it. PySocialForce sets the root logger to DEBUG and opens ``file.log``
@@ -16,22 +20,19 @@ from typing import Any
 
 import numpy as np
 import pytest
-from pydantic import ValidationError
 
-from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
+from arena.crowd.base import RobotView
 from arena.crowd.models.pysocial import TERMS, PySocialModel, sample_segments
-from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import world_segments
 from arena.maps.grid import OccupancyGrid
 from arena.scene.episode import AgentSpawn
 from arena.scene.state import Obstacle, StaticWorld
-from arena.testing.conformance import check_crowd_model
+from tests.crowd.pysocial_kit import EXACT, make_frame, make_state, ours, random_scene
 
 # PySocialForce's term order in Simulator.forces (enable_group): desired, social, obstacle,
 # group coherence (Alt), group repulsion, group gaze (Alt).
 REF_TERMS = ("desired", "social", "obstacle", "group_coherence", "group_repulsion", "group_gaze")
-EXACT = {"cutoff": math.inf, "robot_factor": 0.0, "force_scale": 1.0}
 # README: "forces equal to 2e-15" of the largest reference force (measured: at most 1.1e-15,
 # 2026-11-27, on x86-64 with AVX-512, where numpy's SIMD exp/arctan2 differ most from libm).
 RTOL = 2e-15
@@ -54,105 +55,6 @@ def psf(tmp_path_factory: pytest.TempPathFactory) -> Any:
                 h.close()
         root.setLevel(level)
 
-
-# -- scenes ---------------------------------------------------------------------------------------
-def box(name: str, x: float, y: float, theta: float, half_w: float, half_h: float) -> Obstacle:
-    """A rotated rectangular obstacle (its four edges are obstacle lines)."""
-    fp = np.array([[-half_w, -half_h], [half_w, -half_h], [half_w, half_h], [-half_w, half_h]])
-    return Obstacle(name, "cuboid", np.array([x, y, theta]), fp)
-
-
-def make_state(
-    pos: np.ndarray,
-    vel: np.ndarray,
-    *,
-    vmax: np.ndarray | float = 1.2,
-    groups: np.ndarray | None = None,
-    radii: float = 0.3,
-) -> CrowdState:
-    """A crowd at ``pos`` with velocities ``vel`` (waypoints are irrelevant to the model)."""
-    n = len(pos)
-    spawn = AgentSpawn(
-        positions=np.asarray(pos, dtype=np.float64),
-        radii=np.full(n, radii),
-        vmax=np.broadcast_to(np.asarray(vmax, dtype=np.float64), (n,)).copy(),
-        waypoints=np.asarray(pos, dtype=np.float64)[:, None, :].copy(),
-        num_waypoints=np.ones(n, dtype=np.int64),
-        waypoint_mode=np.zeros(n, dtype=np.int64),
-        kinds=np.zeros(n, dtype=np.int64),
-        groups=None if groups is None else np.asarray(groups, dtype=np.int64),
-    )
-    state = CrowdState.from_spawn(spawn)
-    state.velocities = np.array(vel, dtype=np.float64).reshape(n, 2)
-    return state
-
-
-def random_scene(
-    seed: int, n: int, *, size: tuple[float, float] = (16.0, 12.0), min_side: float = 0.3
-) -> tuple[StaticWorld, CrowdState, np.ndarray]:
-    """A walled room with rotated boxes and a long thin wall; ``n`` agents, groups of 2-4."""
-    rng = np.random.default_rng(seed)
-    w, h = size
-    obstacles = [
-        box(
-            f"b{k}",
-            *rng.uniform([3, 3], [w - 3, h - 3]),
-            rng.uniform(-3, 3),
-            *rng.uniform(min_side / 2, 1.0, 2),
-        )
-        for k in range(3)
-    ]
-    obstacles.append(box("wall", w / 2, h / 2, rng.uniform(-3, 3), 3.0, min_side / 2))
-    world = StaticWorld.build(OccupancyGrid.empty(w, h, 0.1), tuple(obstacles))
-    pos = rng.uniform([0.4, 0.4], [w - 0.4, h - 0.4], (n, 2))
-    groups = np.full(n, -1)
-    order = rng.permutation(n)
-    i = gid = 0
-    while i < n:  # random runs of 1-4 agents; runs of 2+ are groups
-        k = int(rng.integers(1, 5))
-        if k > 1 and i + 1 < n:
-            groups[order[i : i + k]] = gid
-            gid += 1
-        i += k
-    state = make_state(
-        pos, rng.normal(0.0, 0.8, (n, 2)), vmax=rng.uniform(0.5, 1.8, n), groups=groups
-    )
-    state.vmax_factor = rng.choice([0.5, 1.0, 2.0], n)
-    dest = rng.uniform([1, 1], [w - 1, h - 1], (n, 2))
-    near = rng.choice(n, 3, replace=False)  # some inside the goal threshold (brake branch)
-    dest[near] = pos[near] + rng.uniform(-0.1, 0.1, (3, 2))
-    return world, state, dest
-
-
-def make_frame(
-    state: CrowdState,
-    dest: np.ndarray,
-    *,
-    active: np.ndarray | None = None,
-    robots: RobotView | None = None,
-    search: float = math.inf,
-) -> CrowdFrame:
-    """The frame the simulator would build (neighbours found within ``search``)."""
-    n = len(state)
-    return CrowdFrame(
-        state=state,
-        destinations=np.asarray(dest, dtype=np.float64),
-        active=np.ones(n, dtype=bool) if active is None else np.asarray(active, dtype=bool),
-        robots=robots or RobotView.empty(),
-        walls_a=np.zeros((0, 2)),
-        walls_b=np.zeros((0, 2)),
-        neighbors=find_neighbors(state.positions, search),
-        dt=0.1,
-        rng=np.random.default_rng(0),
-    )
-
-
-def ours(world: StaticWorld | None, frame: CrowdFrame, **params: Any) -> Any:
-    """Our model's output for ``frame`` (``world`` None: no obstacles)."""
-    model = PySocialModel(PySocialModel.Params(**params))
-    if world is not None:
-        model.reset(frame.state, world, np.random.default_rng(0))
-    return model.compute(frame)
 
 
 def reference(
@@ -327,201 +229,6 @@ def test_unwrapped_theta_quirk_matches_and_wrap_theta_is_rotation_invariant(psf:
         turned_out.forces["social"], wrapped.forces["social"] @ rot.T, atol=1e-12
     )
 
-
-# -- behaviour ------------------------------------------------------------------------------------
-def test_registered_with_tags_and_frozen_params() -> None:
-    assert CROWD_MODELS.get("pysocial") is PySocialModel
-    assert "pysocial" in CROWD_MODELS.names("social_force")
-    assert "pysocial" in CROWD_MODELS.names("default")
-    model = CROWD_MODELS.build({"type": "pysocial", "force_scale": 0.3})
-    assert model.params.force_scale == 0.3
-    assert model.neighbor_cutoff() == PySocialModel.Params().cutoff
-    with pytest.raises(ValidationError):
-        PySocialModel.Params(not_a_param=1.0)
-    with pytest.raises(ValidationError):
-        PySocialModel.Params().social_factor = 1.0  # type: ignore[misc]
-
-
-def test_terms_sum_to_accelerations_and_force_scale_scales() -> None:
-    world, state, dest = random_scene(2, 20)
-    robots = RobotView(np.array([[8.0, 6.0]]), np.zeros(1), np.array([[0.5, 0.0]]), np.full(1, 0.3))
-    frame = make_frame(state, dest, robots=robots, search=10.0)
-    out = ours(world, frame)
-    assert set(out.forces) == set(TERMS)
-    np.testing.assert_allclose(sum(out.forces.values()), out.accelerations, atol=1e-12)
-    scaled = ours(world, frame, force_scale=0.3)
-    np.testing.assert_allclose(scaled.accelerations, 0.3 * out.accelerations, rtol=1e-12)
-    for name in TERMS:
-        np.testing.assert_allclose(scaled.forces[name], 0.3 * out.forces[name], rtol=1e-12)
-
-
-def test_inactive_agents_get_zero_but_still_repel_and_count_in_groups() -> None:
-    world, state, dest = random_scene(4, 24)
-    active = np.ones(24, dtype=bool)
-    active[[0, 5, 9, 13]] = False
-    everyone = ours(world, make_frame(state, dest, search=10.0))
-    out = ours(world, make_frame(state, dest, active=active, search=10.0))
-    assert np.all(out.accelerations[~active] == 0.0)
-    for name in TERMS:
-        assert np.all(out.forces[name][~active] == 0.0), name
-    np.testing.assert_allclose(
-        out.accelerations[active], everyone.accelerations[active], rtol=1e-12, atol=1e-12
-    )
-
-
-def test_inputs_are_not_mutated_and_results_deterministic() -> None:
-    world, state, dest = random_scene(5, 25)
-    robots = RobotView(np.array([[4.0, 4.0]]), np.zeros(1), np.array([[0.3, 0.1]]), np.full(1, 0.3))
-    frame = make_frame(state, dest, robots=robots, search=10.0)
-    kept = state.copy()
-    kept_frame = {k: np.copy(getattr(frame, k)) for k in ("destinations", "active")}
-    kept_nb = (frame.neighbors.indptr.copy(), frame.neighbors.indices.copy())
-    kept_robots = (robots.positions.copy(), robots.velocities.copy())
-    model = PySocialModel()
-    model.reset(state, world, np.random.default_rng(0))
-    first = model.compute(frame)
-    again = model.compute(frame)  # reused work arrays
-    fresh = ours(world, frame)
-    for k, v in kept.__dict__.items():
-        if isinstance(v, np.ndarray):
-            np.testing.assert_array_equal(getattr(state, k), v, err_msg=k)
-    for k, v in kept_frame.items():
-        np.testing.assert_array_equal(getattr(frame, k), v)
-    np.testing.assert_array_equal(frame.neighbors.indptr, kept_nb[0])
-    np.testing.assert_array_equal(frame.neighbors.indices, kept_nb[1])
-    np.testing.assert_array_equal(robots.positions, kept_robots[0])
-    np.testing.assert_array_equal(robots.velocities, kept_robots[1])
-    for other in (again, fresh):
-        np.testing.assert_array_equal(first.accelerations, other.accelerations)
-        for name in TERMS:
-            np.testing.assert_array_equal(first.forces[name], other.forces[name])
-
-
-def test_group_coherence_pulls_towards_the_centre_of_mass() -> None:
-    pos = np.array([[0.0, 0.0], [4.0, 0.0], [2.0, 3.0], [10.0, 10.0]])
-    state = make_state(pos, np.zeros((4, 2)), groups=[0, 0, 0, -1])
-    dest = pos + np.array([20.0, 0.0])
-    com = pos[:3].mean(axis=0)
-    out = ours(None, make_frame(state, dest))
-    # PySocialForce's gain: (tanh(0 − (k − 1)/2) + 1)/2, its distance being always 0.
-    gain = (math.tanh(-1.0) + 1.0) / 2.0
-    np.testing.assert_allclose(
-        out.forces["group_coherence"][:3], gain * (com - pos[:3]), rtol=1e-12
-    )
-    fixed = ours(None, make_frame(state, dest), coherence_uses_distance=True)
-    dist = np.linalg.norm(com - pos[:3], axis=1, keepdims=True)
-    np.testing.assert_allclose(
-        fixed.forces["group_coherence"][:3],
-        (np.tanh(dist - 1.0) + 1.0) / 2.0 * (com - pos[:3]),
-        rtol=1e-12,
-    )
-    for name in ("group_coherence", "group_repulsion", "group_gaze"):
-        assert np.all(out.forces[name][3] == 0.0), "loners feel no group terms"
-
-
-def test_group_repulsion_pushes_close_members_apart() -> None:
-    pos = np.array([[0.0, 0.0], [0.4, 0.0], [5.0, 0.0], [5.6, 0.0]])
-    state = make_state(pos, np.zeros((4, 2)), groups=[0, 0, 1, 1])
-    out = ours(None, make_frame(state, pos + np.array([0.0, 10.0])))
-    rep = out.forces["group_repulsion"]
-    np.testing.assert_allclose(rep[:2], [[-0.4, 0.0], [0.4, 0.0]], atol=1e-15)
-    assert np.all(rep[2:] == 0.0), "0.6 m apart is beyond the 0.55 m threshold"
-
-
-def test_group_gaze_holds_back_the_leader_and_hurries_the_trailer() -> None:
-    pos = np.array([[0.0, 0.0], [1.5, 0.0]])
-    state = make_state(pos, np.zeros((2, 2)), groups=[0, 0])
-    dest = pos + np.array([10.0, 0.0])  # both walk towards +x; member 1 is ahead
-    gaze = ours(None, make_frame(state, dest)).forces["group_gaze"]
-    assert gaze[0, 0] > 0 and gaze[1, 0] < 0
-    np.testing.assert_allclose(gaze[:, 1], 0.0, atol=1e-15)
-    # |c − r|·cos/|g − r|·ê = 1.5·(±1)/10
-    np.testing.assert_allclose(gaze[:, 0], [0.15, -0.15], rtol=1e-12)
-    on_goal = ours(None, make_frame(state, pos.copy())).forces["group_gaze"]
-    assert np.all(on_goal == 0.0), "standing on the destination: 0, not NaN"
-
-
-def test_robots_act_like_pedestrians_in_the_social_term() -> None:
-    world, state, dest = random_scene(6, 15)
-    rpos = np.array([[5.0, 5.0], [11.0, 7.0]])
-    rvel = np.array([[0.6, -0.2], [-0.4, 0.3]])
-    robots = RobotView(rpos, np.zeros(2), rvel, np.full(2, 0.3))
-    with_robots = ours(
-        world, make_frame(state, dest, robots=robots), **{**EXACT, "robot_factor": 1.0}
-    )
-    # The same robots appended as pedestrians: their social pull on the agents is the robot term.
-    crowd = make_state(
-        np.r_[state.positions, rpos],
-        np.r_[state.velocities, rvel],
-        groups=np.r_[state.group, [-1, -1]],
-    )
-    as_peds = ours(None, make_frame(crowd, np.r_[dest, rpos]), **EXACT)
-    alone = ours(None, make_frame(state, dest), **EXACT)
-    np.testing.assert_allclose(
-        with_robots.forces["robot"],
-        as_peds.forces["social"][:15] - alone.forces["social"],
-        rtol=1e-9,
-        atol=1e-12,
-    )
-    assert np.abs(with_robots.forces["robot"]).max() > 0
-    off = ours(world, make_frame(state, dest, robots=robots), **EXACT)
-    assert np.all(off.forces["robot"] == 0.0)
-    np.testing.assert_array_equal(
-        off.accelerations, ours(world, make_frame(state, dest), **EXACT).accelerations
-    )
-
-
-def test_robot_in_the_way_pushes_an_agent_aside() -> None:
-    state = make_state(np.array([[0.0, 0.0]]), np.array([[1.0, 0.0]]))
-    robots = RobotView(
-        np.array([[2.0, 0.1]]), np.zeros(1), np.array([[-0.5, 0.0]]), np.full(1, 0.3)
-    )
-    out = ours(None, make_frame(state, np.array([[10.0, 0.0]]), robots=robots))
-    f = out.forces["robot"][0]
-    assert f[0] < 0, "brakes"
-    assert f[1] < 0, "sidesteps away from the robot (which is slightly to the left)"
-
-
-def test_cutoff_and_neighbour_lists() -> None:
-    world, state, dest = random_scene(8, 20, size=(8.0, 6.0))
-    exact = ours(world, make_frame(state, dest), **EXACT)
-    within = ours(world, make_frame(state, dest, search=10.0), **{**EXACT, "cutoff": 10.0})
-    np.testing.assert_allclose(within.accelerations, exact.accelerations, rtol=1e-12, atol=1e-12)
-    # A wider neighbour search than the model's cutoff gives the same as the matching search.
-    short = {**EXACT, "cutoff": 2.0}
-    wide = ours(world, make_frame(state, dest, search=math.inf), **short)
-    tight = ours(world, make_frame(state, dest, search=2.0), **short)
-    np.testing.assert_allclose(wide.accelerations, tight.accelerations, rtol=1e-12, atol=1e-12)
-    assert not np.allclose(tight.forces["social"], exact.forces["social"])
-
-
-def test_per_agent_radius_option() -> None:
-    world, state, dest = random_scene(9, 12)
-    state.radii = np.full(12, 0.35)
-    frame = make_frame(state, dest, search=10.0)
-    np.testing.assert_allclose(
-        ours(world, frame, agent_radius=None).accelerations,
-        ours(world, frame).accelerations,
-        rtol=1e-12,
-    )
-    state.radii = np.full(12, 0.2)
-    smaller = ours(world, make_frame(state, dest, search=10.0), agent_radius=None)
-    assert not np.allclose(smaller.forces["obstacle"], ours(world, frame).forces["obstacle"])
-
-
-def test_no_agents_and_no_walls() -> None:
-    state = make_state(np.zeros((0, 2)), np.zeros((0, 2)))
-    out = ours(
-        StaticWorld.build(OccupancyGrid.empty(4.0, 4.0, 0.1)), make_frame(state, np.zeros((0, 2)))
-    )
-    assert out.accelerations.shape == (0, 2)
-    lone = make_state(np.array([[1.0, 1.0]]), np.zeros((1, 2)))
-    out = ours(None, make_frame(lone, np.array([[3.0, 1.0]])))
-    np.testing.assert_allclose(out.accelerations, [[1.2 / 0.5, 0.0]])  # desired only
-
-
-def test_passes_the_crowd_model_conformance_checks() -> None:
-    check_crowd_model(PySocialModel)
 
 
 # -- the compiled kernels against their plain NumPy / Python formulations (to the bit) ----------

@@ -8,7 +8,7 @@ import numpy as np
 
 from arena.maps.grid import OccupancyGrid
 from arena.sensors import Lidar2D
-from tests.sensors.test_lidar2d import random_map, random_spec
+from tests.sensors.lidar_kit import random_map, random_spec
 
 
 def test_wall_faces_cover_every_boundary_edge_once() -> None:
