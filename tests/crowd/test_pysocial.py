@@ -19,7 +19,7 @@ import pytest
 from pydantic import ValidationError
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
-from arena.crowd.models.pysocial import TERMS, PySocialModel, sample_segments
+from arena.crowd.models.pysocial.model import TERMS, PySocialModel, sample_segments
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import world_segments
@@ -526,8 +526,8 @@ def test_passes_the_crowd_model_conformance_checks() -> None:
 
 # -- the compiled kernels against their plain NumPy / Python formulations (to the bit) ----------
 def test_desired_kernel_is_desired_force_to_the_bit() -> None:
-    from arena.crowd.models.pysocial import desired_force
     from arena.crowd.models.pysocial.kernels import _desired
+    from arena.crowd.models.pysocial.model import desired_force
 
     rng = np.random.default_rng(11)
     n = 200

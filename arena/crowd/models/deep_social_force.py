@@ -72,7 +72,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator
 from arena.core import files
 from arena.core.errors import ConfigError
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
-from arena.crowd.models.evacuation import SegmentWalls, SubstepMemory
+from arena.crowd.models.evacuation.model import SegmentWalls, SubstepMemory
 from arena.crowd.walls import world_segments
 
 if TYPE_CHECKING:
