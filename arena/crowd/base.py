@@ -151,6 +151,7 @@ CROWD_MODELS: Registry[CrowdModel] = Registry(
         "pedsim": "arena.crowd.models.pedsim.params:PedsimParams",
         "pysocial": "arena.crowd.models.pysocial.params:PySocialParams",
         "bonding": "arena.crowd.models.evacuation.params:BondingParams",
+        "deep_social_force": "arena.crowd.models.deep_social_force_params:DeepSocialForceParams",
         "rvo2": "arena.crowd.models.orca.params:Rvo2Params",
         "spinny": "arena.crowd.models.pedsim.params:SpinnyParams",
     },

@@ -53,12 +53,13 @@ def test_a_config_validates_crowd_params_without_importing_the_kernels_building_
         "import sys\n"
         "from arena.config.loader import load_config\n"
         "from arena.crowd.base import CROWD_MODELS\n"
-        "def kernels():  # a package's model, obstacles and *kernels modules (import numba)\n"
+        "def kernels():  # a package's model, obstacles, *kernels; deep_social_force's model\n"
         "    mods = [m.split('.') for m in sys.modules if m.startswith('arena.crowd.models.')]\n"
         "    return sorted('.'.join(m) for m in mods if len(m) == 5\n"
-        "                  and (m[4] in ('model', 'obstacles') or m[4].endswith('kernels')))\n"
+        "                  and (m[4] in ('model', 'obstacles') or m[4].endswith('kernels'))\n"
+        "                  or m[3:] == ['deep_social_force'])\n"
         "cfgs = [load_config()]\n"
-        f"for name in {sorted(_KERNEL_PACKAGES)!r}:\n"
+        f"for name in {[*sorted(_KERNEL_PACKAGES), 'deep_social_force']!r}:\n"
         "    cfgs.append(load_config(overrides=[f'crowd.type={name}']))\n"
         "print('loaded', *kernels())\n"
         "for cfg in cfgs:\n"
@@ -74,6 +75,7 @@ def test_a_config_validates_crowd_params_without_importing_the_kernels_building_
         assert f"arena.crowd.models.{package}.kernels" in built
     assert "arena.crowd.models.pysocial.pair_kernels" in built
     assert "arena.crowd.models.orca.obstacles" in built
+    assert "arena.crowd.models.deep_social_force" in built  # its kernels are in the module
 
 
 def test_check_reports_bad_params_as_validate_does_without_building() -> None:
