@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+import arena.core.registry as registry_module
 from arena.core.errors import ConfigError
 from arena.core.registry import Registry
 from arena.crowd.base import CROWD_MODELS
@@ -105,6 +106,8 @@ def test_a_plugin_whose_params_are_not_the_declared_ones_is_refused(
         "    Params = Twin\n"
     )
     monkeypatch.syspath_prepend(str(tmp_path))
+    # the test registry lives in a copy of the registry table, gone after the test
+    monkeypatch.setattr(registry_module, "_ALL", dict(registry_module._ALL))
     reg: Registry[object] = Registry(
         "twin params test", builtins={"m": "twin_params_plugin"},
         params={"m": "twin_params_plugin:Light"},
