@@ -216,7 +216,7 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
     validate_mode("obstacles", cfg.task.obstacles, source=source, path="task.obstacles")
     for i, module in enumerate(cfg.task.modules):
         validate_mode("modules", module, source=source, path=f"task.modules[{i}]")
-    CROWD_MODELS.validate(cfg.crowd, source=source, path="crowd")
+    CROWD_MODELS.check(cfg.crowd, source=source, path="crowd")
     BACKENDS.validate(cfg.sim.backend, source=source, path="sim.backend")
     GLOBAL_PLANNERS.validate(
         cfg.navigation.global_planner, source=source, path="navigation.global_planner"

@@ -9,7 +9,10 @@ Built-in plugins may be declared by name at construction (``builtins={"random":
 "arena.tasks.robot_modes.random"}``): the registry knows the name at once and imports the module
 (which registers the plugin) only when that name is first looked up. A config is then validated
 without importing every implementation, and a registry never imports the modules that register
-with it (which import the registry), so the import graph stays one-way.
+with it (which import the registry), so the import graph stays one-way. A built-in whose module
+is costly to import (numba kernels) may also declare where its ``Params`` live (``params={"orca":
+"arena.crowd.models.orca.params:OrcaParams"}``): :meth:`Registry.check` then validates a block
+against them without importing the implementation.
 
 Example::
 
@@ -71,6 +74,8 @@ class Registry(Generic[T]):
         entry_points: entry-point group scanned for third-party plugins ("arena.local_planners").
         builtins: name -> dotted module that registers that name on import; imported on the
             first lookup of the name (see the module docstring).
+        params: built-in name -> ``"module:Class"``, its ``Params`` model in a light module, for
+            :meth:`check`; the plugin's ``Params`` must be that class (checked on import).
     """
 
     def __init__(
@@ -79,6 +84,7 @@ class Registry(Generic[T]):
         *,
         entry_points: str | None = None,
         builtins: Mapping[str, str] | None = None,
+        params: Mapping[str, str] | None = None,
     ) -> None:
         if kind in _ALL:
             raise ValueError(f"a registry for {kind!r} already exists")
@@ -86,6 +92,9 @@ class Registry(Generic[T]):
         self.entry_point_group = entry_points
         self._entries: dict[str, Entry[T]] = {}
         self._builtins: dict[str, str] = dict(builtins or {})
+        self._params: dict[str, str] = dict(params or {})
+        if not self._params.keys() <= self._builtins.keys():
+            raise ValueError(f"params declared for names that are not built-ins: {self._params}")
         self._entry_points_loaded = entry_points is None
         _ALL[kind] = self
 
@@ -112,7 +121,13 @@ class Registry(Generic[T]):
                 f"duplicate {self.kind} name {name!r}: already registered by "
                 f"{_qualname(self._entries[name].obj)}, now {_qualname(obj)}"
             )
-        self._entries[name] = Entry(name=name, obj=obj, tags=tuple(tags))
+        entry = Entry(name=name, obj=obj, tags=tuple(tags))
+        if name in self._params and entry.params_model is not self._params_of(name):
+            # check() validated configs against the declared model: a twin could drift from it
+            raise RuntimeError(
+                f"{self.kind} {name!r}: Params is not the declared {self._params[name]}"
+            )
+        self._entries[name] = entry
 
     # -- lookup -----------------------------------------------------------------------------
     def _load_entry_points(self) -> None:
@@ -136,6 +151,11 @@ class Registry(Generic[T]):
         importlib.import_module(module)
         if name not in self._entries:
             raise RuntimeError(f"{module} is declared to register {self.kind} {name!r}, did not")
+
+    def _params_of(self, name: str) -> type[BaseModel]:
+        module, _, attr = self._params[name].partition(":")
+        model: type[BaseModel] = getattr(importlib.import_module(module), attr)
+        return model
 
     def _load_all_builtins(self) -> None:
         for name in self._builtins:
@@ -198,6 +218,32 @@ class Registry(Generic[T]):
         Raises:
             ConfigError: naming ``source`` and the key path when the block is invalid.
         """
+        spec = self._spec(spec, source=source, path=path)
+        try:
+            entry = self.entry(spec["type"])
+        except UnknownNameError as e:
+            raise UnknownNameError(
+                e.message, source=source, path=".".join(p for p in (path, "type") if p)
+            ) from None
+        return entry, self._params_for(entry.name, entry.params_model, spec, source, path)
+
+    def check(
+        self, spec: Mapping[str, Any] | str, *, source: str | None = None, path: str | None = None
+    ) -> BaseModel | None:
+        """Validate a block as :meth:`validate` does; return only its params.
+
+        A built-in with declared ``params`` is checked against them without importing its
+        module (a config is validated without compiling the crowd model's kernels).
+        """
+        spec = self._spec(spec, source=source, path=path)
+        name = spec["type"]
+        if isinstance(name, str) and name in self._params and name not in self._entries:
+            return self._params_for(name, self._params_of(name), spec, source, path)
+        return self.validate(spec, source=source, path=path)[1]
+
+    def _spec(
+        self, spec: Mapping[str, Any] | str, *, source: str | None, path: str | None
+    ) -> Mapping[str, Any]:
         if isinstance(spec, str):
             spec = {"type": spec}
         if not isinstance(spec, Mapping):
@@ -212,24 +258,27 @@ class Registry(Generic[T]):
                 source=source,
                 path=path,
             )
-        try:
-            entry = self.entry(spec["type"])
-        except UnknownNameError as e:
-            raise UnknownNameError(
-                e.message, source=source, path=".".join(p for p in (path, "type") if p)
-            ) from None
+        return spec
+
+    def _params_for(
+        self,
+        name: str,
+        model: type[BaseModel] | None,
+        spec: Mapping[str, Any],
+        source: str | None,
+        path: str | None,
+    ) -> BaseModel | None:
         raw = {k: v for k, v in spec.items() if k != "type"}
-        model = entry.params_model
         if model is None:
             if raw:
                 raise ConfigError(
-                    f"{self.kind} {entry.name!r} takes no parameters, got {sorted(raw)}",
+                    f"{self.kind} {name!r} takes no parameters, got {sorted(raw)}",
                     source=source,
                     path=path,
                 )
-            return entry, None
+            return None
         try:
-            return entry, model.model_validate(raw)
+            return model.model_validate(raw)
         except ValidationError as e:
             raise from_validation_error(e, source=source, prefix=path) from None
 

@@ -131,8 +131,9 @@ class CrowdModel(Protocol):
 
 
 _BUILTIN_MODELS = {
-    "bonding": "bonding", "deep_social_force": "deep_social_force", "evacuation": "evacuation",
-    "orca": "orca", "passthrough": "pedsim", "pedsim": "pedsim", "pysocial": "pysocial",
+    "bonding": "bonding", "deep_social_force": "deep_social_force",
+    "evacuation": "evacuation.model", "orca": "orca.model", "passthrough": "pedsim.model",
+    "pedsim": "pedsim.model", "pysocial": "pysocial.model",
     "rvo2": "rvo2", "spinny": "spinny", "waypoint_walker": "walker",
 }
 
@@ -142,4 +143,16 @@ CROWD_MODELS: Registry[CrowdModel] = Registry(
     # name -> the module of arena.crowd.models registering it, imported when first named: a
     # config naming one model does not compile the others
     builtins={name: f"arena.crowd.models.{module}" for name, module in _BUILTIN_MODELS.items()},
+    # the numba models' parameters, apart from their kernels: validating a config compiles none
+    params={
+        "evacuation": "arena.crowd.models.evacuation.params:EvacuationParams",
+        "orca": "arena.crowd.models.orca.params:OrcaParams",
+        "passthrough": "arena.crowd.models.pedsim.params:PedsimParams",
+        "pedsim": "arena.crowd.models.pedsim.params:PedsimParams",
+        "pysocial": "arena.crowd.models.pysocial.params:PySocialParams",
+        "bonding": "arena.crowd.models.evacuation.params:BondingParams",
+        "deep_social_force": "arena.crowd.models.deep_social_force_params:DeepSocialForceParams",
+        "rvo2": "arena.crowd.models.orca.params:Rvo2Params",
+        "spinny": "arena.crowd.models.pedsim.params:SpinnyParams",
+    },
 )

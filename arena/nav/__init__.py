@@ -1,7 +1,7 @@
 """Navigation: global planners, local planners and the stack that runs them for one robot.
 
-Importing :mod:`arena.nav` registers the built-in planners; :class:`NavigationStack` is the
-pipeline a task drives every control tick.
+The local-planner registry names its built-ins and imports one when a config names it;
+:class:`NavigationStack` is the pipeline a task drives every control tick.
 """
 
 from arena.nav.global_planners import GLOBAL_PLANNERS, AStarPlanner, GlobalPlanner
@@ -10,8 +10,8 @@ from arena.nav.local_planners import (
     LOCAL_PLANNERS,
     LocalObservation,
     LocalPlanner,
-    PurePursuitPlanner,
 )
+from arena.nav.local_planners.pure_pursuit import PurePursuitPlanner
 from arena.nav.stack import NavigationConfig, NavigationStack, NavStatus
 
 __all__ = [

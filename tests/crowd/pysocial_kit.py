@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from arena.crowd.base import CrowdFrame, RobotView
-from arena.crowd.models.pysocial import PySocialModel
+from arena.crowd.models.pysocial.model import PySocialModel
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.maps.grid import OccupancyGrid

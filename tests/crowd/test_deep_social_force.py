@@ -13,7 +13,8 @@ import pytest
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
 from arena.crowd.models import deep_social_force as dsf_module
-from arena.crowd.models.deep_social_force import WEIGHTS, DeepSocialForce, MLPPotential, _dvdb
+from arena.crowd.models.deep_social_force import DeepSocialForce, _dvdb
+from arena.crowd.models.deep_social_force_params import WEIGHTS, MLPPotential
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.scene.episode import AgentSpawn

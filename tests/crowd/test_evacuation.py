@@ -9,7 +9,7 @@ import pytest
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
 from arena.crowd.models.bonding import Bonding, group_partners
-from arena.crowd.models.evacuation import Evacuation
+from arena.crowd.models.evacuation.model import Evacuation
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.maps.grid import OccupancyGrid

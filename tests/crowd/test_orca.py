@@ -12,12 +12,8 @@ import pytest
 from pydantic import ValidationError
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
-from arena.crowd.models.orca import (
-    Obstacles,
-    OrcaModel,
-    orca_velocities,
-    preferred_velocities,
-)
+from arena.crowd.models.orca.model import OrcaModel, orca_velocities, preferred_velocities
+from arena.crowd.models.orca.obstacles import Obstacles
 from arena.crowd.models.rvo2 import Rvo2Model, counter_clockwise, world_polygons
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState

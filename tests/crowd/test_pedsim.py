@@ -9,8 +9,7 @@ import pytest
 from pydantic import ValidationError
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
-from arena.crowd.models.pedsim import TERMS, PassthroughModel, PedsimModel
-from arena.crowd.models.pedsim.model import _deviation
+from arena.crowd.models.pedsim.model import TERMS, PassthroughModel, PedsimModel, _deviation
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import grid_wall_segments

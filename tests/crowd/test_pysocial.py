@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from arena.crowd.base import RobotView
-from arena.crowd.models.pysocial import TERMS, PySocialModel, sample_segments
+from arena.crowd.models.pysocial.model import TERMS, PySocialModel, sample_segments
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import world_segments
 from arena.maps.grid import OccupancyGrid
@@ -233,8 +233,8 @@ def test_unwrapped_theta_quirk_matches_and_wrap_theta_is_rotation_invariant(psf:
 
 # -- the compiled kernels against their plain NumPy / Python formulations (to the bit) ----------
 def test_desired_kernel_is_desired_force_to_the_bit() -> None:
-    from arena.crowd.models.pysocial import desired_force
     from arena.crowd.models.pysocial.kernels import _desired
+    from arena.crowd.models.pysocial.model import desired_force
 
     rng = np.random.default_rng(11)
     n = 200

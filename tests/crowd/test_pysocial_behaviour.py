@@ -13,7 +13,7 @@ import pytest
 from pydantic import ValidationError
 
 from arena.crowd.base import CROWD_MODELS, RobotView
-from arena.crowd.models.pysocial import TERMS, PySocialModel
+from arena.crowd.models.pysocial.model import TERMS, PySocialModel
 from arena.maps.grid import OccupancyGrid
 from arena.scene.state import StaticWorld
 from arena.testing.conformance import check_crowd_model

@@ -9,7 +9,7 @@ import pytest
 from pydantic import ValidationError
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, RobotView
-from arena.crowd.models.pedsim import TERMS, PedsimModel
+from arena.crowd.models.pedsim.model import TERMS, PedsimModel
 from arena.crowd.models.spinny import SpinnyModel
 from arena.maps.grid import OccupancyGrid
 from arena.scene.state import StaticWorld

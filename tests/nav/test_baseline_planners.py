@@ -10,12 +10,9 @@ import pytest
 
 from arena.config import load_config
 from arena.experiment import run_experiment
-from arena.nav.local_planners import (
-    LOCAL_PLANNERS,
-    OrcaPlanner,
-    SocialForcePlanner,
-)
-from arena.nav.local_planners.orca_planner import orca_velocity
+from arena.nav.local_planners import LOCAL_PLANNERS
+from arena.nav.local_planners.orca_planner import OrcaPlanner, orca_velocity
+from arena.nav.local_planners.social_force import SocialForcePlanner
 from tests.nav.planner_kit import (
     BEHIND_ASIDE,
     CAR,

@@ -10,7 +10,8 @@ import pytest
 
 from arena.config import load_config
 from arena.experiment import run_experiment
-from arena.nav.local_planners import LOCAL_PLANNERS, DWAPlanner
+from arena.nav.local_planners import LOCAL_PLANNERS
+from arena.nav.local_planners.dwa import DWAPlanner
 from tests.nav.planner_kit import (
     BEHIND_ASIDE,
     CAR,

@@ -12,7 +12,8 @@ pytest.importorskip("casadi")
 
 from arena.config import load_config
 from arena.experiment import run_experiment
-from arena.nav.local_planners import LOCAL_PLANNERS, MPCPlanner
+from arena.nav.local_planners import LOCAL_PLANNERS
+from arena.nav.local_planners.mpc import MPCPlanner
 from arena.robots.limits import VelocityLimits
 from tests.nav.planner_kit import (
     BEHIND_ASIDE,

@@ -10,7 +10,8 @@ import pytest
 
 from arena.core.errors import ConfigError
 from arena.core.types import Pose2D
-from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation, PurePursuitPlanner
+from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation
+from arena.nav.local_planners.pure_pursuit import PurePursuitPlanner
 from arena.robots.limits import VelocityLimits
 
 DT = 0.1

@@ -11,7 +11,8 @@ import pytest
 from arena.config import load_config
 from arena.core.types import Pose2D
 from arena.experiment import run_experiment
-from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation, TEBPlanner
+from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation
+from arena.nav.local_planners.teb import TEBPlanner
 from tests.nav.planner_kit import (
     BEHIND_ASIDE,
     CAR,

@@ -35,10 +35,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
-from pydantic import ConfigDict, Field
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame
-from arena.crowd.models.evacuation import TERMS, Evacuation
+from arena.crowd.models.evacuation.model import TERMS, Evacuation
+from arena.crowd.models.evacuation.params import BondingParams
 
 IntArray = NDArray[np.int64]
 
@@ -50,28 +50,11 @@ class Bonding(Evacuation):
     The bonding term is our derivation after Xu & Duh (2010); see the module docstring.
     """
 
-    class Params(Evacuation.Params):
-        """Parameters of :class:`Bonding`: :class:`Evacuation`'s plus the bonding term."""
+    Params = BondingParams
 
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        bond_strength: float = Field(
-            200.0,
-            ge=0,
-            description="N, C: saturated bonding pull (ours: of the order of the 160 N "
-            "driving force; Xu & Duh's calibrated value was not retrievable)",
-        )
-        bond_range: float = Field(
-            1.0, gt=0, description="m, D: gap over which the pull saturates (ours)"
-        )
-        comfort_gap: float = Field(
-            0.5,
-            ge=0,
-            description="m, c: surface-to-surface gap between relatives with no pull (ours)",
-        )
+    params: BondingParams
 
-    params: Params
-
-    def __init__(self, params: Params | None = None) -> None:
+    def __init__(self, params: BondingParams | None = None) -> None:
         super().__init__(params or self.Params())
 
     def _bond_pairs(self, frame: CrowdFrame) -> tuple[IntArray, IntArray]:

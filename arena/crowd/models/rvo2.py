@@ -28,16 +28,11 @@ from __future__ import annotations
 from typing import ClassVar
 
 import numpy as np
-from pydantic import Field
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame
-from arena.crowd.models.orca import (
-    FloatArray,
-    Obstacles,
-    OrcaModel,
-    OrcaParams,
-    preferred_velocities,
-)
+from arena.crowd.models.orca.model import FloatArray, OrcaModel, preferred_velocities
+from arena.crowd.models.orca.obstacles import Obstacles
+from arena.crowd.models.orca.params import Rvo2Params
 from arena.crowd.simulator import episode_segments
 from arena.crowd.state import CrowdState
 from arena.crowd.walls import grid_walls
@@ -81,16 +76,6 @@ def world_polygons(world: StaticWorld) -> list[FloatArray]:
         if len(poly) >= 2:
             polys.append(poly)
     return polys
-
-
-class Rvo2Params(OrcaParams):
-    """Parameters of :class:`Rvo2Model`: those of ORCA plus the obstacle horizon."""
-
-    time_horizon_obst: float = Field(
-        2.0,
-        gt=0,
-        description="s, collisions with walls this far ahead are avoided (RVO2 timeHorizonObst)",
-    )
 
 
 @CROWD_MODELS.register("rvo2", tags=("velocity_obstacle",))

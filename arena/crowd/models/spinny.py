@@ -17,10 +17,10 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
-from arena.crowd.models.pedsim import PedsimModel
+from arena.crowd.models.pedsim.model import PedsimModel
+from arena.crowd.models.pedsim.params import SpinnyParams
 from arena.crowd.state import CrowdState
 from arena.scene.state import StaticWorld
 
@@ -31,16 +31,11 @@ FloatArray = NDArray[np.float64]
 class SpinnyModel(PedsimModel):
     """Arena's demo: pedsim's acceleration rotated by ``k·angle_per_step_deg`` at step ``k``."""
 
-    class Params(PedsimModel.Params):
-        """Parameters of :class:`SpinnyModel`: pedsim's, plus the turn per step."""
+    Params = SpinnyParams
 
-        angle_per_step_deg: float = Field(
-            3.0, description="deg, added to the rotation every step (Arena 3°; 0 gives pedsim)"
-        )
-
-    def __init__(self, params: Params | None = None) -> None:
+    def __init__(self, params: SpinnyParams | None = None) -> None:
         super().__init__(params or self.Params())
-        self.params: SpinnyModel.Params
+        self.params: SpinnyParams
         self._steps = 0
 
     def reset(self, state: CrowdState, world: StaticWorld, rng: np.random.Generator) -> None:

@@ -154,8 +154,18 @@ class LocalPlanner(Protocol):
         ...
 
 
+_BUILTIN_PLANNERS = {
+    "cohan": "cohan", "crowdnav": "crowdnav", "dwa": "dwa", "mpc": "mpc", "orca": "orca_planner",
+    "pure_pursuit": "pure_pursuit", "rlca": "rlca", "rosnav_rl": "learned", "sarl": "crowdnav",
+    "social_force": "social_force", "teb": "teb",
+}
+
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
-    "local planner", entry_points="arena.local_planners"
+    "local planner",
+    entry_points="arena.local_planners",
+    # name -> the module of arena.nav.local_planners registering it, imported when first named:
+    # a config does not import every planner (``orca`` compiles the ORCA crowd kernels)
+    builtins={name: f"arena.nav.local_planners.{m}" for name, m in _BUILTIN_PLANNERS.items()},
 )
 
 

@@ -85,10 +85,10 @@ from typing import TYPE_CHECKING, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.base import CROWD_MODELS, CrowdFrame, ModelOutput
 from arena.crowd.models.evacuation.kernels import _distinct_owners, _helbing_substeps, _stiffness
+from arena.crowd.models.evacuation.params import EvacuationParams
 from arena.crowd.walls import WallIndex, world_segments
 
 if TYPE_CHECKING:
@@ -207,51 +207,9 @@ class Evacuation:
 
     output: ClassVar[Literal["acceleration", "velocity"]] = "acceleration"
 
-    class Params(BaseModel):
-        """Parameters of :class:`Evacuation` (defaults: Helbing, Farkas & Vicsek 2000)."""
+    Params = EvacuationParams
 
-        model_config = ConfigDict(frozen=True, extra="forbid")
-        social_strength: float = Field(
-            2000.0, ge=0, description="N, A: strength of the psychological repulsion (paper)"
-        )
-        social_range: float = Field(
-            0.08, gt=0, description="m, B: range of the psychological repulsion (paper)"
-        )
-        body_stiffness: float = Field(
-            1.2e5, ge=0, description="kg/s², k: body compression coefficient (paper)"
-        )
-        friction: float = Field(
-            2.4e5, ge=0, description="kg/(m·s), κ: sliding friction coefficient (paper)"
-        )
-        mass: float = Field(
-            80.0, gt=0, description="kg, m: pedestrian mass (paper; Arena's plugin used 180)"
-        )
-        tau: float = Field(
-            0.5, gt=0, description="s, τ: relaxation time (paper; Arena's plugin used 1.0)"
-        )
-        robots_as_bodies: bool = Field(
-            True, description="robots repel, push and rub pedestrians like another body"
-        )
-        interaction_range: float = Field(
-            2.0,
-            gt=0,
-            description="m, centre distance beyond which pedestrians, walls and robots are "
-            "ignored; the social term there is below 1e-4 N for radii 0.3 m",
-        )
-        max_substep: float = Field(
-            0.005,
-            gt=0,
-            description="s, longest internal integration step; shortened further while "
-            "contacts are stiffer (see module docstring)",
-        )
-        max_substeps: int = Field(
-            400,
-            ge=1,
-            description="most sub-steps per step (bounds the cost of deep overlaps, e.g. "
-            "agents spawned on top of each other; the speed cap keeps the result bounded)",
-        )
-
-    def __init__(self, params: Params | None = None) -> None:
+    def __init__(self, params: EvacuationParams | None = None) -> None:
         self.params = params or self.Params()
         self.last_substeps = 0  # sub-steps used by the last compute() (for diagnostics)
         self._memory = SubstepMemory()
