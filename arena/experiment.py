@@ -44,7 +44,7 @@ from arena.core.files import make_dir
 from arena.core.geometry import segment_lengths
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
-from arena.crowd.simulator import CrowdSimulator
+from arena.crowd.driver import build_driver
 from arena.eval.counterfactual import align, replay_crowd
 from arena.eval.io import save_record
 from arena.eval.record import EpisodeMeta, EpisodeRecord
@@ -286,7 +286,7 @@ def run_episode(
     spawn = episode.robots[0]
     robot = spawn.model
     seed, idx = cfg.seed, episode.index
-    crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
+    crowd = build_driver(cfg.crowd, cfg.pedestrians)
     state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
     stack = NavigationStack.from_config(
         cfg.navigation, robot_radius=robot.radius,

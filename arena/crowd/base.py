@@ -20,6 +20,10 @@ Writing a model::
         def neighbor_cutoff(self) -> float: return 5.0      # m, or math.inf for all pairs
         def reset(self, state, world, rng) -> None: ...
         def compute(self, frame) -> ModelOutput: ...
+
+A model that moves its pedestrians itself (``fast_social_force``: one compiled kernel per step)
+is a :class:`DriverModel` instead: its ``make_driver`` gives the whole pedestrian driver, and
+:func:`arena.crowd.driver.build_driver` picks the one or the other for a config.
 """
 
 from __future__ import annotations
@@ -34,8 +38,10 @@ from arena.core.registry import Registry
 
 if TYPE_CHECKING:
     from arena.crowd.neighbors import Neighbors
+    from arena.crowd.simulator import PedestrianConfig
     from arena.crowd.state import CrowdState
     from arena.scene.state import StaticWorld
+    from arena.sim.backend import PedestrianDriver
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -130,9 +136,25 @@ class CrowdModel(Protocol):
         ...
 
 
+@runtime_checkable
+class DriverModel(Protocol):
+    """A crowd model that moves its pedestrians itself, outside the crowd simulator.
+
+    Registered in :data:`CROWD_MODELS` like any model (``Params``, built by name), it gives a
+    whole :class:`~arena.sim.backend.PedestrianDriver` of its own instead of accelerations, so
+    none of the simulator's layers (social states, groups, start-up modes, the integrator)
+    apply. :func:`arena.crowd.driver.build_driver` returns its :meth:`make_driver`.
+    """
+
+    def make_driver(self, pedestrians: PedestrianConfig | None = None) -> PedestrianDriver:
+        """A fresh driver; ``pedestrians`` is the config's ``pedestrians:`` block."""
+        ...
+
+
 _BUILTIN_MODELS = {
     "bonding": "bonding", "deep_social_force": "deep_social_force",
-    "evacuation": "evacuation.model", "orca": "orca.model", "passthrough": "pedsim.model",
+    "evacuation": "evacuation.model", "fast_social_force": "fast_social_force.model",
+    "orca": "orca.model", "passthrough": "pedsim.model",
     "pedsim": "pedsim.model", "pysocial": "pysocial.model",
     "rvo2": "rvo2", "spinny": "spinny", "waypoint_walker": "walker",
 }
@@ -146,6 +168,9 @@ CROWD_MODELS: Registry[CrowdModel] = Registry(
     # the numba models' parameters, apart from their kernels: validating a config compiles none
     params={
         "evacuation": "arena.crowd.models.evacuation.params:EvacuationParams",
+        "fast_social_force": (
+            "arena.crowd.models.fast_social_force.params:FastSocialForceParams"
+        ),
         "orca": "arena.crowd.models.orca.params:OrcaParams",
         "passthrough": "arena.crowd.models.pedsim.params:PedsimParams",
         "pedsim": "arena.crowd.models.pedsim.params:PedsimParams",

@@ -23,7 +23,7 @@ from numba import njit
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
-from arena.crowd.base import CROWD_MODELS, CrowdFrame, CrowdModel, RobotView
+from arena.crowd.base import CrowdFrame, CrowdModel, RobotView
 from arena.crowd.integrator import integrate
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.social import SocialStates
@@ -84,13 +84,6 @@ class CrowdSimulator:
         self.config = config or PedestrianConfig()
         self.social: Any = None
         self._state: CrowdState | None = None
-
-    @classmethod
-    def build(
-        cls, crowd: dict[str, Any] | str, pedestrians: PedestrianConfig | None = None
-    ) -> CrowdSimulator:
-        """Build from the config's ``crowd:`` block (the model) and ``pedestrians:`` block."""
-        return cls(CROWD_MODELS.build(crowd, path="crowd"), pedestrians)
 
     @property
     def state(self) -> CrowdState:

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from arena.crowd.simulator import CrowdSimulator
+from arena.crowd.driver import build_driver
 from arena.scene.state import RobotStates, StaticWorld
 from arena.sim.backend import split_rng
 
@@ -82,7 +82,7 @@ def replay_crowd(
     Returns:
         The positions of every pedestrian at rows ``0 … steps``.
     """
-    crowd = CrowdSimulator.build(crowd_config, pedestrian_config)
+    crowd = build_driver(crowd_config, pedestrian_config)
     crowd_rng, _ = split_rng(rng)
     world = StaticWorld.build(episode.grid, episode.obstacles)
     agents = crowd.reset(episode.agents, world, crowd_rng)

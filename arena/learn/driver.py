@@ -27,7 +27,7 @@ from arena.config.schema import ExperimentConfig
 from arena.core.errors import ConfigError, PlanningError, SamplingError, StartOccupied
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
-from arena.crowd.simulator import CrowdSimulator
+from arena.crowd.driver import build_driver
 from arena.learn.actions import ActionDecoder
 from arena.learn.config import EnvConfig, SubgoalObsConfig
 from arena.learn.keywords import load_with_keywords
@@ -267,7 +267,7 @@ class EpisodeDriver:
         self.next_index += 1
         ep = self.generator.episode(idx)
         self.episode = ep
-        crowd = CrowdSimulator.build(self.cfg.crowd, self.cfg.pedestrians)
+        crowd = build_driver(self.cfg.crowd, self.cfg.pedestrians)
         self.state = self.backend.reset(ep, crowd, derive_rng(self.seed, "episode", idx, "sim"))
         self.steps = 0
         self.robot_steps = np.zeros(self.n_robots, dtype=np.int64)

@@ -120,9 +120,10 @@ def _crowd_episode(grid: OccupancyGrid, starts: np.ndarray, waypoints: np.ndarra
 
 
 def _run_crowd(make_model, spawn: AgentSpawn, grid: OccupancyGrid, steps: int, seed: int = 3):
-    from arena.crowd.simulator import CrowdSimulator, PedestrianConfig
+    from arena.crowd.driver import driver_of
+    from arena.crowd.simulator import PedestrianConfig
 
-    sim = CrowdSimulator(make_model(), PedestrianConfig(social_states=False, group_fraction=0.0))
+    sim = driver_of(make_model(), PedestrianConfig(social_states=False, group_fraction=0.0))
     world = StaticWorld.build(grid)
     robots = RobotStates(
         ("r",),
@@ -143,11 +144,11 @@ def _run_crowd(make_model, spawn: AgentSpawn, grid: OccupancyGrid, steps: int, s
 
 
 def check_crowd_model(make_model, *, reaches_waypoints: bool = True) -> None:
-    """Check a crowd model inside the crowd simulator (social states off).
+    """Check a crowd model as it runs (social states off): in the crowd simulator, or alone.
 
-    Agents move finitely, within their speed caps and deterministically; they reach their
-    waypoints in an empty room; and nobody walks into a wall in 1,000 steps of two opposing
-    streams in a corridor.
+    A :class:`~arena.crowd.base.DriverModel` runs as its own driver. Agents move finitely,
+    within their speed caps and deterministically; they reach their waypoints in an empty room;
+    and nobody walks into a wall in 1,000 steps of two opposing streams in a corridor.
 
     Args:
         make_model: builds a fresh model instance.

@@ -7,7 +7,7 @@ import arena.plugins  # noqa: F401
 from arena.core.geometry import polygons_overlap
 from arena.core.registry import all_registries
 from arena.crowd.base import CROWD_MODELS
-from arena.crowd.simulator import CrowdSimulator
+from arena.crowd.driver import build_driver
 from arena.maps.generators import MAP_GENERATORS
 from arena.maps.grid import OccupancyGrid
 from arena.maps.sources import MAP_SOURCES
@@ -42,7 +42,7 @@ def test_backend(name):
     check_backend(lambda: BACKENDS.build(name))
     for crowd in CROWD_MODELS.names():
         check_backend(
-            lambda: BACKENDS.build(name), lambda c=crowd: CrowdSimulator.build(c), steps=5
+            lambda: BACKENDS.build(name), lambda c=crowd: build_driver(c), steps=5
         )
 
 

@@ -38,7 +38,7 @@ def test_loading_a_config_imports_only_the_crowd_model_it_names():
     # the numba social-force and ORCA models (the orca local planner too, not named), the
     # learned one and the panic models are not compiled
     for other in ("pysocial", "pedsim", "evacuation", "bonding", "deep_social_force", "spinny",
-                  "orca", "rvo2"):
+                  "orca", "rvo2", "fast_social_force"):
         assert f"arena.crowd.models.{other}" not in loaded
 
 
@@ -46,6 +46,7 @@ def test_loading_a_config_imports_only_the_crowd_model_it_names():
 _KERNEL_PACKAGES = {
     "pysocial": "pysocial", "pedsim": "pedsim", "passthrough": "pedsim", "spinny": "pedsim",
     "evacuation": "evacuation", "bonding": "evacuation", "orca": "orca", "rvo2": "orca",
+    "fast_social_force": "fast_social_force",
 }
 
 

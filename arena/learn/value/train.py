@@ -66,7 +66,7 @@ from arena.config.loader import load_config
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ArenaError, PlanningError
 from arena.core.rng import derive_rng
-from arena.crowd.simulator import CrowdSimulator
+from arena.crowd.driver import build_driver
 from arena.learn.value.network import (
     CADRL_LAYOUT,
     SARL_LAYOUT,
@@ -280,7 +280,7 @@ def run_training_episode(cfg: ExperimentConfig, generator: TaskGenerator,
     episode = generator.episode(index)
     spawn = episode.robots[0]
     robot = spawn.model
-    crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
+    crowd = build_driver(cfg.crowd, cfg.pedestrians)
     state = backend.reset(episode, crowd, derive_rng(cfg.seed, "episode", index, "sim"))
     stack = NavigationStack.from_config(cfg.navigation, robot_radius=robot.radius)
     stack.local_planner = planner
