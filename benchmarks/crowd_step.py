@@ -1,13 +1,15 @@
 """Crowd step time for every registered crowd model at 10, 100 and 1,000 agents, with walls.
 
-    python benchmarks/crowd_step.py [--sizes 10 100 1000] [--steps 50]
+    python benchmarks/crowd_step.py [--sizes 10 100 1000] [--steps 50] [--world small_office]
 
-World: a 40 x 40 m hall with outer walls, two interior walls with doors and 12 pillars.
-Agents start at random free positions and walk loops between two random waypoints. Timed: one
-``CrowdSimulator.step`` (neighbour search, model, integrator with the wall guard), social states
-off so the figure is the model's cost; one core. References in the same run when installed:
-PyPI ``pysocialforce`` (``Simulator.step``) and ``pyrvo`` (RVO2 C++, ``do_step``; preferred
-velocities set before the timer, as our figure includes computing them).
+World: a 40 x 40 m hall with outer walls, two interior walls with doors and 12 pillars (or a
+packaged world's map with ``--world``). Agents start at random free positions and walk loops
+between two random waypoints. Timed: one ``CrowdSimulator.step`` (neighbour search, model,
+integrator with the wall guard), social states off so the figure is the model's cost, or one
+step of a model's own driver (``fast_social_force``: the whole step is the model); one core.
+References in the same run when installed: PyPI ``pysocialforce`` (``Simulator.step``) and
+``pyrvo`` (RVO2 C++, ``do_step``; preferred velocities set before the timer, as our figure
+includes computing them).
 """
 
 from __future__ import annotations
@@ -25,10 +27,13 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 
 from arena.crowd.base import CROWD_MODELS  # noqa: E402
+from arena.crowd.driver import driver_of  # noqa: E402
 from arena.crowd.models.rvo2 import world_polygons  # noqa: E402
 from arena.crowd.simulator import CrowdSimulator, PedestrianConfig  # noqa: E402
 from arena.crowd.walls import world_segments  # noqa: E402
 from arena.maps.grid import OccupancyGrid  # noqa: E402
+from arena.maps.io import load_map  # noqa: E402
+from arena.maps.sources import resolve_world  # noqa: E402
 from arena.scene.episode import WAYPOINT_LOOP, AgentSpawn  # noqa: E402
 from arena.scene.state import RobotStates, StaticWorld  # noqa: E402
 
@@ -82,11 +87,17 @@ NO_ROBOTS = RobotStates(
 
 
 def time_model(name: str, world: StaticWorld, n: int, steps: int) -> tuple[float, float]:
-    """ms per CrowdSimulator step, and ms of it spent in the model's ``compute``."""
-    sim = CrowdSimulator(CROWD_MODELS.build(name), PedestrianConfig(social_states=False))
+    """ms per driver step, and ms of it spent in the model's ``compute`` (all for a driver)."""
+    sim = driver_of(CROWD_MODELS.build(name), PedestrianConfig(social_states=False))
     sim.reset(spawn(world, n), world, np.random.default_rng(1))
     for _ in range(3):  # warm-up: JIT and caches
         sim.step(NO_ROBOTS, 0.1)
+    if not isinstance(sim, CrowdSimulator):  # the model's own driver: all of it is the model
+        t0 = time.perf_counter()
+        for _ in range(steps):
+            sim.step(NO_ROBOTS, 0.1)
+        full = 1e3 * (time.perf_counter() - t0) / steps
+        return full, full
     inner = sim.model.compute
     spent = [0.0]
 
@@ -173,10 +184,15 @@ def main() -> None:
     ap.add_argument("--sizes", type=int, nargs="+", default=[10, 100, 1000])
     ap.add_argument("--steps", type=int, default=50)
     ap.add_argument("--models", nargs="*", default=None)
+    ap.add_argument("--world", default=None, help="a packaged world's map instead of the hall")
     args = ap.parse_args()
-    world = hall()
+    if args.world:
+        world = StaticWorld.build(load_map(resolve_world(args.world)))
+        where = f"{args.world} map"
+    else:
+        world, where = hall(), "40 x 40 m hall with walls"
     names = args.models or CROWD_MODELS.names()
-    print(f"crowd step, ms per step (1 core; 40 x 40 m hall with walls; {args.steps} steps)")
+    print(f"crowd step, ms per step (1 core; {where}; {args.steps} steps)")
     print("full = CrowdSimulator.step (neighbour search + model + integrator with wall guard);")
     print("model = the model's compute(), including the neighbour search it triggers (lazy)")
     head = "".join(f"{f'full {n:,d}':>13}{f'model {n:,d}':>13}" for n in args.sizes)
@@ -184,6 +200,9 @@ def main() -> None:
     for name in names:
         row = [time_model(name, world, n, args.steps) for n in args.sizes]
         print(f"{name:<20}" + "".join(f"{full:13.3f}{model:13.3f}" for full, model in row))
+    if args.world:  # pysocialforce rejects some packaged maps' wall segments
+        print("(references run on the hall only)")
+        return
     for label, fn in (("ref: pysocialforce", time_pysocialforce), ("ref: pyrvo (C++)", time_pyrvo)):
         vals = [
             fn(world, n, max(3, args.steps // 5) if n >= 1000 else args.steps) for n in args.sizes

@@ -198,8 +198,10 @@ def test_people_walk_their_loops_in_order() -> None:
     far = _robots([(-50.0, -50.0)], [0.3])
     for _ in range(600):
         driver.step(far, DT)
+        s = driver.state
+        np.testing.assert_array_equal(s.destinations, s.current_waypoints)
         for a in range(2):
-            k = int(driver.state.waypoint_index[a])
+            k = int(s.waypoint_index[a])
             if k != visits[a][-1]:
                 visits[a].append(k)
     # 60 s at up to 1.56 m/s around a 48 m square: at least one full loop each, in order

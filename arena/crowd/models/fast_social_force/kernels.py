@@ -98,7 +98,7 @@ def step_crowd(
     wps: F64, n_wp: I64, wp_mode: I64, wp_idx: I64, rand: F64, rand_k: int,
     distg: F32, res: float, gx0: float, gy0: float,
     seg_a: F64, seg_b: F64, run_box: F64, robot_xy: F64, robot_r: F64,
-    prm: F64, dt: float, out_pos: F64, out_vel: F64,
+    prm: F64, dt: float, out_pos: F64, out_vel: F64, out_dest: F64,
 ) -> int:
     """One social-force step of one world's ``n`` pedestrians.
 
@@ -127,6 +127,7 @@ def step_crowd(
         dt: s.
         out_pos: ``(n, 2)`` new positions, written.
         out_vel: ``(n, 2)`` new velocities, written.
+        out_dest: ``(n, 2)`` the waypoint each pedestrian walked to this step (m), written.
 
     Returns:
         ``rand_k`` after the step.
@@ -182,6 +183,8 @@ def step_crowd(
             gx = wps[a, k, 0] - x
             gy = wps[a, k, 1] - y
             gd = math.hypot(gx, gy)
+        out_dest[a, 0] = wps[a, k, 0]
+        out_dest[a, 1] = wps[a, k, 1]
         ax = -vx / tau
         ay = -vy / tau
         if gd > 1e-9:

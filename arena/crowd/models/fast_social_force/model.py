@@ -138,16 +138,16 @@ class FastSocialForceDriver:
         if len(s):
             out_pos = np.empty_like(s.positions)
             out_vel = np.empty_like(s.velocities)
+            out_dest = np.empty_like(s.destinations)
             self._rand_k = step_crowd(
                 s.positions, s.velocities, s.headings, s.radii, s.vmax, s.waypoints,
                 s.num_waypoints, s.waypoint_mode, s.waypoint_index, self._rand, self._rand_k,
                 self._distg, self._res, self._gx0, self._gy0, self._seg_a, self._seg_b,
                 self._run_box, np.ascontiguousarray(robots.poses[:, :2]),
                 np.ascontiguousarray(robots.radii, dtype=np.float64), self._prm, float(dt),
-                out_pos, out_vel,
+                out_pos, out_vel, out_dest,
             )
-            s.positions, s.velocities = out_pos, out_vel
-            s.destinations = s.current_waypoints
+            s.positions, s.velocities, s.destinations = out_pos, out_vel, out_dest
             if self._rand_k > RAND_TABLE // 2:
                 self._rand = self._rng.random(RAND_TABLE)
                 self._rand_k = 0
