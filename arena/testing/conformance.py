@@ -139,7 +139,9 @@ def _run_crowd(make_model, spawn: AgentSpawn, grid: OccupancyGrid, steps: int, s
     caps = []
     for _ in range(steps):
         out.append(sim.step(robots, 0.1))
-        caps.append(sim.state.vmax * sim.state.vmax_factor)
+        # a driver of its own may keep no CrowdState: then its speeds are only checked finite
+        state = getattr(sim, "state", None)
+        caps.append(np.inf if state is None else state.vmax * state.vmax_factor)
     return out, caps
 
 
