@@ -373,3 +373,32 @@ def test_a_robot_spawn_episode_runs_in_native2d() -> None:
         gap = min(gap, float(np.hypot(*(s.agents.positions[0] - [8.0, 10.0]))))
     assert s.agents.positions[0, 0] > 12.0  # got past the robot
     assert gap > 0.3 + load_robot("burger").circumscribed_radius  # without touching it
+
+
+@pytest.mark.filterwarnings("ignore:.*symmetric and normalized space")  # Arena's raw units
+@pytest.mark.filterwarnings("ignore:crowd 'fast_social_force' has no social states")
+def test_social_nav_env_runs_on_the_fast_crowd(monkeypatch: pytest.MonkeyPatch) -> None:
+    from gymnasium.utils.env_checker import check_env
+
+    from arena.learn.env import SocialNavEnv
+    from tests.learn.helpers import small_cfg, small_robot
+
+    seen: list[AgentStates] = []  # what the model's driver returned, step by step
+    step = FastSocialForceDriver.step
+
+    def spied(self: FastSocialForceDriver, robots: RobotStates, dt: float) -> AgentStates:
+        seen.append(step(self, robots, dt))
+        return seen[-1]
+
+    monkeypatch.setattr(FastSocialForceDriver, "step", spied)
+    cfg = small_cfg("crowd.type=fast_social_force",
+                    "learning.env.observation.pedestrians.enabled=true")
+    env = SocialNavEnv(cfg, robot=small_robot())
+    check_env(env, skip_render_check=True)
+    env.reset(seed=3)
+    seen.clear()
+    for _ in range(20):
+        env.step(0)
+    assert len(seen) >= 20  # the env's people are this model's
+    moved = seen[-1].positions - seen[0].positions
+    assert len(seen[0]) == 3 and np.hypot(*moved.T).max() > 0.5
