@@ -187,6 +187,33 @@ def test_every_robot_and_the_other_pedestrians_repel_as_the_formula_says() -> No
     assert st.velocities[3, 0] == 0.0 and st.velocities[0, 0] < 0.0  # pushed off both robots
 
 
+def test_pair_repulsion_through_cells_equals_all_pairs_and_is_antisymmetric() -> None:
+    from arena.crowd.models.fast_social_force.kernels import pair_repulsion
+
+    rng = np.random.default_rng(5)
+    # 300 people over 40 x 25 m (many cells), two coincident, one pair at exactly the cutoff
+    pos = rng.uniform([0.0, 0.0], [40.0, 25.0], (300, 2))
+    pos[7] = pos[3]
+    pos[11] = pos[10] + [3.0, 0.0]
+    radii = rng.uniform(0.2, 0.35, 300)
+    a_p, b_p, cutoff = 2.1, 0.3, 3.0
+    got = pair_repulsion(pos, radii, a_p, b_p, cutoff)
+    off = pos[:, None] - pos[None]
+    d = np.hypot(off[..., 0], off[..., 1])
+    np.fill_diagonal(d, np.inf)
+    near = d < cutoff
+    assert not near[10, 11]  # at the cutoff: no force
+    d_eff = np.where(d < 1e-9, 1.0, d)
+    unit = np.where((d < 1e-9)[..., None], 0.0, off / d_eff[..., None])
+    unit[3, 7], unit[7, 3] = [-1.0, 0.0], [1.0, 0.0]  # coincident: lower index toward -x
+    f = np.where(near, a_p * np.exp((radii[:, None] + radii[None] - d_eff) / b_p), 0.0)
+    expected = (f[..., None] * unit).sum(axis=1)
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+    assert near.sum() > 300  # plenty of pairs, across cell borders
+    assert np.abs(got.sum(axis=0)).max() < 1e-12  # each pair adds opposite forces
+    assert pair_repulsion(pos[:1], radii[:1], a_p, b_p, cutoff).tolist() == [[0.0, 0.0]]
+
+
 # -- behaviour --------------------------------------------------------------------------------
 def test_people_walk_their_loops_in_order() -> None:
     corners = np.array([[4.0, 4.0], [16.0, 4.0], [16.0, 16.0], [4.0, 16.0]])

@@ -93,6 +93,83 @@ def edge_run_boxes(seg_a: F64, seg_b: F64) -> F64:
 
 
 @njit(cache=True)
+def pair_repulsion(pos: F64, radii: F64, a_p: float, b_p: float, cutoff: float) -> F64:
+    """``(n, 2)`` the pedestrians' mutual repulsion, ``Σ_b A_p·exp((r_a + r_b − d)/B_p)·n_ba``.
+
+    Pairs closer than ``cutoff`` (m) only, found through a grid of cells at least ``cutoff``
+    wide (the 3 x 3 cells around a pedestrian hold every such pair): O(n) for a crowd of
+    bounded density. Each pair is computed once and added to both with opposite signs, so the
+    forces are antisymmetric to the bit. Coincident pedestrians (``d < 1e-9`` m) push apart
+    along x, the lower index toward −x, as if ``d = 1`` m.
+    """
+    n = pos.shape[0]
+    acc = np.zeros((n, 2))
+    if n < 2:
+        return acc
+    x0 = y0 = math.inf
+    x1 = y1 = -math.inf
+    for a in range(n):  # NaN coordinates fail every comparison: left out of the box
+        if pos[a, 0] < x0:
+            x0 = pos[a, 0]
+        if pos[a, 0] > x1:
+            x1 = pos[a, 0]
+        if pos[a, 1] < y0:
+            y0 = pos[a, 1]
+        if pos[a, 1] > y1:
+            y1 = pos[a, 1]
+    if not (x1 >= x0 and y1 >= y0):
+        x0 = x1 = y0 = y1 = 0.0
+    # cells of at least the cutoff, and at most about 4n of them (a sparse crowd on a big map)
+    per_axis = 2.0 * math.sqrt(n) + 1.0
+    cell = max(cutoff, (x1 - x0) / per_axis, (y1 - y0) / per_axis)
+    nx = int((x1 - x0) / cell) + 1
+    ny = int((y1 - y0) / cell) + 1
+    cid = np.empty(n, dtype=np.int64)
+    for a in range(n):
+        cx = (pos[a, 0] - x0) / cell
+        cy = (pos[a, 1] - y0) / cell
+        ix = min(int(cx), nx - 1) if cx > 0.0 else 0  # NaN: cell 0
+        iy = min(int(cy), ny - 1) if cy > 0.0 else 0
+        cid[a] = iy * nx + ix
+    # counting sort: the pedestrians of cell c are order[start[c]:start[c + 1]], by index
+    start = np.zeros(nx * ny + 1, dtype=np.int64)
+    for a in range(n):
+        start[cid[a] + 1] += 1
+    for c in range(nx * ny):
+        start[c + 1] += start[c]
+    fill = start[:-1].copy()
+    order = np.empty(n, dtype=np.int64)
+    for a in range(n):
+        order[fill[cid[a]]] = a
+        fill[cid[a]] += 1
+    for a in range(n):
+        ix = cid[a] % nx
+        iy = cid[a] // nx
+        for gy in range(max(iy - 1, 0), min(iy + 2, ny)):
+            for gx in range(max(ix - 1, 0), min(ix + 2, nx)):
+                c = gy * nx + gx
+                for q in range(start[c], start[c + 1]):
+                    b = order[q]
+                    if b <= a:
+                        continue
+                    dx = pos[a, 0] - pos[b, 0]
+                    dy = pos[a, 1] - pos[b, 1]
+                    d = math.hypot(dx, dy)
+                    if not d < cutoff:
+                        continue
+                    if d < 1e-9:  # coincident: a fixed, index-ordered axis (a < b)
+                        dx, dy, d = -1.0, 0.0, 1.0
+                    f = a_p * math.exp((radii[a] + radii[b] - d) / b_p)
+                    fx = f * dx / d
+                    fy = f * dy / d
+                    acc[a, 0] += fx
+                    acc[a, 1] += fy
+                    acc[b, 0] -= fx
+                    acc[b, 1] -= fy
+    return acc
+
+
+@njit(cache=True)
 def step_crowd(
     pos: F64, vel: F64, heading: F64, radii: F64, vmax: F64,
     wps: F64, n_wp: I64, wp_mode: I64, wp_idx: I64, rand: F64, rand_k: int,
@@ -147,20 +224,7 @@ def step_crowd(
     # conservative under rounding: every edge that can act is still visited, in order, so the
     # sum is the same as without culling; most pedestrians are far from most obstacles.
     far2 = (cutoff + 1e-9) * (cutoff + 1e-9)
-    # Pair distances and repulsion magnitudes, once per unordered pair: both are symmetric bit
-    # for bit (x_b - x_a is exactly -(x_a - x_b), hypot ignores signs, r_a + r_b = r_b + r_a),
-    # so pedestrian a reads the very values it used to compute, at half the hypot/exp calls.
-    pair_d = np.empty((n, n))
-    pair_f = np.empty((n, n))
-    for a in range(n):
-        for b in range(a + 1, n):
-            d = math.hypot(pos[a, 0] - pos[b, 0], pos[a, 1] - pos[b, 1])
-            pair_d[a, b] = d
-            if d >= cutoff:  # the tests of the loop below, NaN included
-                continue
-            if d < 1e-9:
-                d = 1.0  # coincident: the force acts at d = 1 (see below)
-            pair_f[a, b] = a_p * math.exp((radii[a] + radii[b] - d) / b_p)
+    social = pair_repulsion(pos, radii, a_p, b_p, cutoff)
     for a in range(n):
         x, y = pos[a, 0], pos[a, 1]
         vx, vy = vel[a, 0], vel[a, 1]
@@ -191,20 +255,8 @@ def step_crowd(
             ax += vmax[a] * gx / gd / tau
             ay += vmax[a] * gy / gd / tau
         # -- other pedestrians --
-        for b in range(n):
-            if b == a:
-                continue
-            lo, hi = (a, b) if a < b else (b, a)
-            d = pair_d[lo, hi]
-            if d >= cutoff:
-                continue
-            dx = x - pos[b, 0]
-            dy = y - pos[b, 1]
-            if d < 1e-9:  # coincident: push apart along a fixed, index-ordered axis
-                dx, dy, d = (1.0 if a > b else -1.0), 0.0, 1.0
-            f = pair_f[lo, hi]  # a_p·exp((r_a + r_b - d)/b_p)
-            ax += f * dx / d
-            ay += f * dy / d
+        ax += social[a, 0]
+        ay += social[a, 1]
         # -- robots, in row order --
         for j in range(robot_xy.shape[0]):
             dx = x - robot_xy[j, 0]
