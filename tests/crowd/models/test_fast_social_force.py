@@ -266,6 +266,42 @@ def test_random_waypoints_are_drawn_from_the_seed_and_never_repeat_the_current_o
     assert a != c  # the choices come from the generator
 
 
+def test_pedestrians_avoid_walls_and_each_other(tmp_path) -> None:
+    # BatchSim's crowd test, carried over: eight 10 x 10 m episodes with a wall across, three
+    # boxes and six people; 200 steps with the robot standing at its start.
+    from arena.maps.io import save_map
+
+    occ = np.zeros((200, 200), dtype=bool)
+    occ[:2, :] = occ[-2:, :] = occ[:, :2] = occ[:, -2:] = True
+    occ[100:104, 0:120] = True
+    path = tmp_path / "m.yaml"
+    save_map(OccupancyGrid.from_occupied(occ, 0.05), path)
+    task = TaskConfig(
+        robots={"type": "random", "min_goal_distance": 2.0, "clearance": 1.0},
+        obstacles={"type": "random", "static": 3, "dynamic": 6},
+    )
+    gen = TaskGenerator(task, map_spec={"type": "file", "path": str(path)},
+                        robots=[load_robot("jackal")], seed=3)
+    min_gap, walked = np.inf, 0.0
+    for ep in (gen.episode(i) for i in range(8)):
+        states = _run(FastSocialForceDriver(), ep, _at_start(ep), 200, seed=1)
+        n = len(ep.agents)
+        for st in states[1:]:
+            p = st.positions
+            d = np.hypot(*(p[:, None] - p[None]).transpose(2, 0, 1))
+            d[np.arange(n), np.arange(n)] = np.inf
+            min_gap = min(min_gap, d.min())
+        p = states[-1].positions
+        walked = max(walked, np.abs(p - states[0].positions).max())
+        g = ep.grid
+        col = ((p[:, 0] - g.origin[0]) // g.resolution).astype(int)
+        row = ((p[:, 1] - g.origin[1]) // g.resolution).astype(int)
+        assert not g.occupied[row, col].any()
+        assert (np.asarray(g.distance)[row, col] > 0).all()
+    assert min_gap > 0.2  # nobody walks through anybody
+    assert walked > 1.0  # they do walk
+
+
 def test_people_keep_off_walls_and_obstacles_on_a_packaged_world(office_episode: Episode) -> None:
     ep = office_episode
     grid = ep.grid
@@ -429,3 +465,26 @@ def test_social_nav_env_runs_on_the_fast_crowd(monkeypatch: pytest.MonkeyPatch) 
     assert len(seen) >= 20  # the env's people are this model's
     moved = seen[-1].positions - seen[0].positions
     assert len(seen[0]) == 3 and np.hypot(*moved.T).max() > 0.5
+
+
+@pytest.mark.filterwarnings("ignore:crowd 'fast_social_force' has no social states")
+def test_the_benchmark_runner_runs_the_fast_crowd(tmp_path) -> None:
+    # What `arena bench` runs, in a worker process, with the crowd named by the base config.
+    from arena.config.schema import ExperimentConfig
+    from arena.eval.io import load_record
+    from arena.eval.runner import run_benchmark
+    from arena.eval.store import load_results
+    from tests.eval._suites import stage
+
+    suite = tmp_path / "suite.yaml"
+    suite.write_text("stages:\n" + stage("people", 2, "burger", dynamic=(3, 3)))
+    contest = tmp_path / "contest.yaml"
+    contest.write_text("contestants:\n  - {name: pure_pursuit, local_planner: pure_pursuit}\n")
+    cfg = ExperimentConfig(seed=0, crowd={"type": "fast_social_force"})
+    run = run_benchmark(suite, contest, tmp_path / "run", base_cfg=cfg)
+    table = load_results(run)
+    assert table.num_rows == 2 and set(table["error"].to_pylist()) <= {None, ""}
+    for rel in table["record"].to_pylist():
+        record = load_record(run / rel)
+        assert record.meta.config["crowd"] == {"type": "fast_social_force"}  # as it ran
+        assert set(record.ped_state.tolist()) == {int(SocialState.WALKING)}
