@@ -159,7 +159,7 @@ _BUILTIN_MODELS = {
     "rvo2": "rvo2", "spinny": "spinny", "waypoint_walker": "walker",
 }
 
-CROWD_MODELS: Registry[CrowdModel] = Registry(
+CROWD_MODELS: Registry[CrowdModel | DriverModel] = Registry(
     "crowd model",
     entry_points="arena.crowd_models",
     # name -> the module of arena.crowd.models registering it, imported when first named: a

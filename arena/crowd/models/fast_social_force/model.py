@@ -20,7 +20,7 @@ It is fast because it is a whole :class:`~arena.sim.backend.PedestrianDriver` of
 compiled kernel per step, not a model inside :class:`~arena.crowd.simulator.CrowdSimulator`.
 What that leaves out, on purpose: no social states (everyone is always walking:
 ``SocialState.WALKING``), no groups, no start-up modes (everyone walks from t = 0), no per-kind
-speed profiles (elders walk at their own ``vmax``), no leg model; of the ``pedestrians:`` block
+speed profiles (elders walk at their own ``vmax``); of the ``pedestrians:`` block
 it reads nothing (a warning says so when social states or groups are asked for).
 """
 
