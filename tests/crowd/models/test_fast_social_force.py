@@ -118,6 +118,15 @@ def test_config_validates_its_params_and_bad_ones_give_one_line() -> None:
     assert FastSocialForceModel.Params is FastSocialForceParams
 
 
+def test_a_bad_param_on_the_command_line_is_one_line(monkeypatch, capsys) -> None:
+    code, out, err = run_cli(monkeypatch, capsys, "run", "crowd.type=fast_social_force",
+                             "crowd.cutoff=0")
+    assert code == 2 and "Traceback" not in out + err
+    assert " ".join(err.split()) == (
+        "error: override 'crowd.cutoff=0': crowd.cutoff: Input should be greater than 0 (got 0)"
+    )
+
+
 # -- reference values -------------------------------------------------------------------------
 def test_obstacle_edge_forces_match_the_formula_near_and_far() -> None:
     # Four 1 m boxes in a 20 m room; one pedestrian per box: beside an edge (in reach), off a
