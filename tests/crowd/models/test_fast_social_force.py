@@ -391,10 +391,17 @@ def test_groups_and_start_up_modes_of_the_spawn_are_ignored() -> None:
     )
     far = _robots([(-50.0, -50.0)], [0.3])
     runs = []
-    for sp in (base, spawn):
-        driver = FastSocialForceDriver()
-        driver.reset(sp, StaticWorld.build(_room()), np.random.default_rng(0))
-        runs.append([driver.step(far, DT).positions for _ in range(20)])
+    warn_once.cache_clear()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for sp in (base, spawn, spawn):
+            driver = FastSocialForceDriver()
+            driver.reset(sp, StaticWorld.build(_room()), np.random.default_rng(0))
+            runs.append([driver.step(far, DT).positions for _ in range(20)])
+    assert [str(w.message) for w in caught] == [  # once, for the spawn that has them
+        "crowd 'fast_social_force' has no groups and no start-up modes: the episode's "
+        "pedestrian groups and start-up modes ignored"
+    ]
     assert np.array_equal(np.array(runs[0]), np.array(runs[1]))  # both walk at once, alone
     assert runs[1][-1][0, 1] > 6.0
 

@@ -110,8 +110,23 @@ class FastSocialForceDriver:
     def reset(self, spawn: AgentSpawn, world: StaticWorld, rng: np.random.Generator) -> AgentStates:
         """Place the episode's pedestrians at rest, walking to their first waypoints.
 
-        Groups and start-up modes of the spawn are ignored (everyone walks alone, at once).
+        Groups and start-up modes of the spawn are ignored (everyone walks alone, at once; a
+        warning says so once).
         """
+        ignored = [
+            what
+            for what, given in (
+                ("groups", spawn.groups is not None and bool(np.any(spawn.groups >= 0))),
+                ("start-up modes",
+                 spawn.startup_mode is not None and bool(np.any(spawn.startup_mode != 0))),
+            )
+            if given
+        ]
+        if ignored:
+            warn_once(
+                f"crowd 'fast_social_force' has no groups and no start-up modes: the episode's "
+                f"pedestrian {' and '.join(ignored)} ignored"
+            )
         s = CrowdState.from_spawn(spawn)
         n = len(s)
         s.vmax_factor = np.full(n, self.params.max_speed_factor)
