@@ -55,6 +55,26 @@ Footprint = Annotated[
 ]
 
 
+SHAPE3D_KINDS = ("box", "cylinder", "table", "chair", "shelf", "rack", "pallet", "pallet_jack",
+                 "desk", "office_chair", "panel", "tree")
+"""How a model may be assembled in 3-D (see :mod:`arena.sim.mujoco.shapes`)."""
+
+
+class Shape3D(BaseModel):
+    """How the 3-D world builder assembles a model from primitives (scaled to footprint, height).
+
+    Only the parameters a kind uses matter; each has a default that suits common furniture.
+    """
+
+    model_config = ConfigDict(frozen=True, extra="forbid")
+    kind: Literal[SHAPE3D_KINDS]  # type: ignore[valid-type]
+    legs: int = Field(4, ge=3, le=8, description="table legs")
+    levels: int = Field(4, ge=1, le=12, description="shelf boards / rack beam levels")
+    seat_height: float = Field(0.45, gt=0, description="m, chairs")
+    mast: bool = Field(False, description="pallet jack: a lifting mast instead of a handle")
+    crown_radius: float = Field(1.5, gt=0, description="m, tree crown (above the footprint)")
+
+
 class ObstacleModel(BaseModel):
     """One entry of the library."""
 
@@ -62,6 +82,9 @@ class ObstacleModel(BaseModel):
     footprint: Footprint
     height: float = Field(gt=0, description="m")
     description: str = ""
+    shape3d: Shape3D | None = Field(
+        None, description="3-D assembly; a model without one cannot be built in a 3-D world"
+    )
 
     def polygon(self) -> NDArray[np.float64]:
         """``(k, 2)`` footprint polygon in the model frame (m)."""

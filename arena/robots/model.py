@@ -148,6 +148,8 @@ class RobotModel(BaseModel):
             distances. Taken from Arena as is: it is not always the footprint's circumscribed
             radius (see :attr:`circumscribed_radius`).
         footprint: collision shape in the body frame (m).
+        height: body height above the floor (m) for 3-D worlds; ``None`` where unknown (such a
+            robot cannot be placed in a 3-D world).
         laser: the 2-D laser scanner.
         actions: discrete and continuous action spaces for learning agents.
         sources: where the numbers come from (free text, one citation per entry).
@@ -161,6 +163,7 @@ class RobotModel(BaseModel):
     kinematics: dict[str, Any] = Field(description="{type: <kinematics name>, **params}")
     radius: float = Field(gt=0, description="m, Arena's robot_radius (inflation, safety)")
     footprint: Footprint
+    height: float | None = Field(None, gt=0, le=5, description="m, body height (3-D worlds)")
     laser: LidarSpec
     actions: Actions
     sources: tuple[str, ...] = Field((), description="citations for the numbers")

@@ -1,0 +1,8 @@
+"""3-D worlds for MuJoCo (and Gazebo export), built from Arena's 2-D scene.
+
+:mod:`.world` turns an occupancy grid, placed obstacles, robots and pedestrians into a
+:class:`~.scene.Scene3D`: a plain description of bodies and primitive geoms that needs no
+simulator. :mod:`.mjcf` writes it as MJCF (and compiles it with the optional ``mujoco``
+package, extra ``arena[3d]``); :mod:`.sdf` writes a Gazebo SDF world. The MuJoCo simulator
+backend will drive the mocap bodies of robots and people named here each step.
+"""
