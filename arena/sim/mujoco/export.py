@@ -14,6 +14,7 @@ from arena.core.files import make_dir, read_json
 from arena.maps.obstacles import make_obstacle
 from arena.maps.sources import MapResult, packaged_worlds, resolve_scenario, world_folder
 from arena.scene.episode import AgentSpawn
+from arena.scene.state import Obstacle
 from arena.sim.mujoco.mjcf import to_mjcf
 from arena.sim.mujoco.scene import Scene3D, WorldParams
 from arena.sim.mujoco.sdf import to_sdf
@@ -34,7 +35,7 @@ class ExportSource:
     source: str
 
 
-def _generated_obstacles(folder: Path) -> list:  # type: ignore[type-arg]
+def _generated_obstacles(folder: Path) -> list[Obstacle]:
     """Obstacles of a world folder written by ``arena maps generate`` (``map/obstacles.json``)."""
     path = folder / "map" / "obstacles.json"
     if not path.is_file():

@@ -7,6 +7,8 @@ writes, and ``arena maps export --format mjcf`` saves the same text.
 from __future__ import annotations
 
 import math
+import os
+import sys
 import xml.etree.ElementTree as ET
 from typing import TYPE_CHECKING, Any
 
@@ -75,7 +77,13 @@ def to_mjcf(scene: Scene3D) -> str:
 
 
 def import_mujoco() -> Any:
-    """The ``mujoco`` module, or a one-line error saying how to install it."""
+    """The ``mujoco`` module, or a one-line error saying how to install it.
+
+    Without a display, offscreen rendering goes through EGL unless ``MUJOCO_GL`` says otherwise
+    (``osmesa`` for machines without a GPU driver); MuJoCo reads the variable on import.
+    """
+    if "mujoco" not in sys.modules and not os.environ.get("DISPLAY"):
+        os.environ.setdefault("MUJOCO_GL", "egl")
     try:
         import mujoco
     except ImportError:
