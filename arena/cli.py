@@ -236,7 +236,7 @@ def plugins(
     print_plugins(console, kind, name, as_json=as_json)
 
 
-maps_app = typer.Typer(help="Generate and list maps.", no_args_is_help=True)
+maps_app = typer.Typer(help="Generate, list and export maps.", no_args_is_help=True)
 app.add_typer(maps_app, name="maps")
 
 

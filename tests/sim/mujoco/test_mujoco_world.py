@@ -158,3 +158,27 @@ def test_render_is_deterministic_and_shows_walls() -> None:
                    - wall / wall.max() * 255).max(axis=-1) < 25
     assert close.mean() > 0.05
     assert (first.sum(axis=-1) > 30).mean() > 0.5  # mostly scene, not background
+
+
+def test_episode_world_from_a_scenario() -> None:
+    from arena.maps.io import load_map
+    from arena.maps.sources import resolve_scenario, resolve_world
+    from arena.sim.mujoco.world import build_episode_world
+    from arena.tasks.scenario import load_scenario, scenario_episode
+
+    scenario = load_scenario(resolve_scenario("small_office/default"))
+    episode = scenario_episode(scenario, load_map(resolve_world("small_office")),
+                               [load_robot("burger")], time_limit=60.0)
+    scene = build_episode_world(episode)
+    model = compile_model(scene)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    robot = episode.robots[0]
+    np.testing.assert_allclose(data.xpos[model.body(f"robot/{robot.name}").id][:2],
+                               robot.start.as_array()[:2])
+    assert model.nmocap == 1 + 3 * len(episode.agents)
+    assert len(episode.agents) == 3 and len(scene.actors) == 3
+    np.testing.assert_allclose(data.xpos[model.body("person/2").id][:2],
+                               episode.agents.positions[2])
+    assert model.body("obstacle/shelf_1").id > 0
+    assert scene.wall_boxes == 28
