@@ -7,6 +7,7 @@ a sphere of ``crown_radius`` on top, reaches beyond its trunk's footprint.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from arena.maps.obstacles import Shape3D
@@ -41,8 +42,6 @@ def _slab(name: str, e: Extent, round_: bool, z0: float, z1: float, material: st
 def _legs(e: Extent, round_: bool, n: int, thick: float, z1: float,
           material: str) -> list[Geom]:
     """``n`` legs at the footprint's rim (round) or its four corners (else), floor to ``z1``."""
-    import math
-
     x0, y0, x1, y1 = e
     cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
     if round_:
