@@ -26,7 +26,6 @@ import json
 import math
 import re
 import time
-import traceback
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from datetime import datetime
@@ -39,20 +38,17 @@ from numpy.typing import NDArray
 
 import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ArenaError, PlanningError
 from arena.core.files import make_dir
-from arena.core.geometry import segment_lengths
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
+from arena.episode.navigation import NavigationController, build_stack
+from arena.episode.runner import EpisodeHooks, EpisodeRunner, describe_exception
 from arena.eval.counterfactual import align, replay_crowd
 from arena.eval.io import save_record
+from arena.eval.metrics.arena_set import path_length_value
 from arena.eval.record import EpisodeMeta, EpisodeRecord
 from arena.eval.recorder import Recorder
-from arena.maps.raster import planning_grid
-from arena.nav.intermediate.base import Pedestrians
-from arena.nav.local_planners.base import LocalObservation
-from arena.nav.stack import NavigationStack, NavStatus
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.scene.episode import Episode
@@ -101,21 +97,6 @@ class EpisodeResult:
         }
 
 
-def describe_exception(e: BaseException) -> str:
-    """One line for a failed episode: ``"<Type>: message"`` (its first line).
-
-    Anything but an :class:`ArenaError` (a plugin's bug) gets ``" (at file.py:line)"``, where it
-    was raised.
-    """
-    lines = str(e).strip().splitlines()
-    text = f"{type(e).__name__}: {lines[0] if lines else ''}".rstrip(": ")
-    if not isinstance(e, ArenaError):
-        tb = traceback.extract_tb(e.__traceback__)
-        if tb:
-            text += f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})"
-    return text
-
-
 def failed_result(cfg: ExperimentConfig, episode: Episode, error: str,
                   wall_time: float = 0.0) -> EpisodeResult:
     """The result of an episode that failed before it could be simulated (outcome ``error``).
@@ -147,106 +128,6 @@ def make_episode(
         cfg, [robot] if robot is not None else None
     )
     return generator.episode(index)
-
-
-class EpisodeRecorder:
-    """Collects per-step robot and pedestrian state and writes them as CSV."""
-
-    ROBOT_COLUMNS = (
-        "step",
-        "time",
-        "x",
-        "y",
-        "theta",
-        "vx",
-        "vy",
-        "omega",
-        "cmd_vx",
-        "cmd_vy",
-        "cmd_omega",
-        "min_range",
-        "collision",
-    )
-    AGENT_COLUMNS = (
-        "step",
-        "time",
-        "id",
-        "x",
-        "y",
-        "vx",
-        "vy",
-        "heading",
-        "radius",
-        "kind",
-        "state",
-    )
-
-    def __init__(self) -> None:
-        self.robot_rows: list[np.ndarray] = []
-        self.agent_rows: list[np.ndarray] = []
-
-    def record(self, s: SimState) -> None:
-        """Store robot 0 and every pedestrian at this snapshot."""
-        r = s.robots
-        scan = r.scans[0]
-        min_range = float(scan.min()) if scan.size else math.nan
-        self.robot_rows.append(
-            np.concatenate(
-                [
-                    [s.step, s.time],
-                    r.poses[0],
-                    r.twists[0],
-                    r.commands[0],
-                    [min_range, float(s.collisions.any[0])],
-                ]
-            )
-        )
-        a = s.agents
-        n = len(a)
-        if n:
-            self.agent_rows.append(
-                np.column_stack(
-                    [
-                        np.full(n, s.step),
-                        np.full(n, s.time),
-                        a.ids,
-                        a.positions,
-                        a.velocities,
-                        a.headings,
-                        a.radii,
-                        a.kinds,
-                        a.states,
-                    ]
-                )
-            )
-
-    @property
-    def poses(self) -> np.ndarray:
-        """``(steps, 3)`` robot poses."""
-        return np.array([row[2:5] for row in self.robot_rows])
-
-    def write(self, folder: Path) -> dict[str, str]:
-        """Write ``trajectory.csv`` and ``agents.csv``; return their paths."""
-        traj = folder / "trajectory.csv"
-        _write_csv(traj, self.ROBOT_COLUMNS, np.array(self.robot_rows), int_cols=(0, 12))
-        agents = folder / "agents.csv"
-        rows = np.concatenate(self.agent_rows) if self.agent_rows else np.zeros((0, 11))
-        _write_csv(agents, self.AGENT_COLUMNS, rows, int_cols=(0, 2, 9, 10))
-        return {"trajectory": str(traj), "agents": str(agents)}
-
-
-def _fmt_pose(p: Pose2D) -> str:
-    return f"[{p.x:.3f}, {p.y:.3f}, {p.theta:.3f}]"
-
-
-def _write_csv(
-    path: Path, header: tuple[str, ...], rows: np.ndarray, int_cols: tuple[int, ...]
-) -> None:
-    with path.open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(header)
-        for row in rows:
-            w.writerow([int(v) if i in int_cols else f"{v:.6g}" for i, v in enumerate(row)])
 
 
 def run_episode(
@@ -286,117 +167,26 @@ def run_episode(
     spawn = episode.robots[0]
     robot = spawn.model
     seed, idx = cfg.seed, episode.index
-    crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
-    state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
-    stack = NavigationStack.from_config(
-        cfg.navigation, robot_radius=robot.radius,
-        footprint_radius=robot.inscribed_radius or None,  # narrow passages: the body fits
-    )
-    stack.scan_range_max = float(robot.laser.range_max)
-    stack.goal_tolerance_xy = min(stack.goal_tolerance_xy, 0.9 * episode.goal_radius)
-    if episode.goal_tolerance_angle is not None:
-        stack.goal_tolerance_yaw = float(episode.goal_tolerance_angle)
-    limits = robot.limits()
-    laser = robot.laser
-    angles = laser.angles() + laser.mount[2]
-    scan_origin = np.array(laser.mount[:2])
     dt = cfg.sim.dt
-    goal = spawn.goal
-
-    recorder = EpisodeRecorder()
-    rec = Recorder()
-    control_s: list[float] = []  # wall time of each navigation-stack call (global+inter+local)
-    recorder.record(state)
-    rec.record(state)
-    states = [state] if video else []
-    # per recorded state the plan and goal it was driven by, so a video shows each at its time
-    views: list[tuple[NDArray[np.float64], Pose2D]] = []
-    outcome, error = Outcome.TIMEOUT, ""
-    collisions, touching = 0, False
-    jumps: list[int] = []  # recorder rows reached by a teleport (not driven)
-    wall_start = time.perf_counter()
-    try:
-        stack.reset(planning_grid(episode), spawn.start, goal)
-        if video:
-            views.append((stack.path, goal))
-        while True:
-            update = runtime.update(state.time, state.robots.poses, state.agents.positions)
-            if 0 in update.reached:
-                rec.event(state.time, "goal_reached", "robot 0")
-            if update.reset:
-                rec.event(state.time, "reset", "forced reset")
-                outcome = Outcome.ABORTED
-                break
-            if update.done:
-                outcome = Outcome.SUCCESS
-                break
-            for i, target in sorted(update.teleports.items()):
-                state = backend.teleport(i, target)
-                if i == 0:
-                    jumps.append(len(recorder.robot_rows))
-                    touching = bool(state.collisions.any[0])
-                    rec.event(state.time, "teleport", f"robot 0 to {_fmt_pose(target)}")
-            if 0 in update.goals:
-                goal = update.goals[0]
-                rec.event(state.time, "new_goal", f"robot 0 to {_fmt_pose(goal)}")
-            if 0 in update.goals or 0 in update.teleports:
-                stack.reset(
-                    planning_grid(episode), Pose2D.from_array(state.robots.poses[0]), goal,
-                    time=state.time,
-                )
-            pose = state.robots.poses[0]
-            if state.time >= episode.time_limit - 1e-9:
-                outcome = Outcome.TIMEOUT
-                break
-            obs = LocalObservation(
-                pose=pose,
-                twist=state.robots.twists[0],
-                goal=goal,
-                path=stack.path,
-                limits=limits,
-                robot_radius=robot.radius,
-                dt=dt,
-                scan_ranges=state.robots.scans[0],
-                scan_angles=angles,
-                scan_origin=scan_origin,
-                time=state.time,
-                kinematics=robot.kinematics_type,
-            )
-            agents = state.agents
-            peds = Pedestrians(
-                positions=agents.positions, velocities=agents.velocities,
-                kinds=agents.kinds, states=agents.states,
-            )
-            t_ctl = time.perf_counter()
-            cmd = np.asarray(stack.step(obs, peds), dtype=np.float64)
-            control_s.append(time.perf_counter() - t_ctl)
-            if stack.status is NavStatus.STUCK:  # every recovery behaviour failed
-                outcome = Outcome.STUCK
-                break
-            if cmd.shape != (3,) or not np.all(np.isfinite(cmd)):
-                raise ArenaError(f"the navigation stack returned an invalid command {cmd!r}")
-            if realtime:
-                ahead = wall_start + state.time + dt - time.perf_counter()
-                if ahead > 0:
-                    time.sleep(ahead)
-            state = backend.step(cmd[None, :], dt)
-            if on_step is not None:
-                on_step(state.time, episode.time_limit)
-            recorder.record(state)
-            rec.record(state)
-            if video:
-                states.append(state)
-                views.append((stack.path, goal))
-            hit = bool(state.collisions.any[0])
-            collisions += hit and not touching  # count contact events, not contact steps
-            touching = hit
-    except PlanningError as e:
-        outcome, error = Outcome.PLANNER_FAILURE, f"{type(e).__name__}: {e}"
-    except Exception as e:  # a faulty plugin (any exception) costs this episode, not the run
-        outcome, error = Outcome.ERROR, describe_exception(e)
-
-    rec.event(state.time, "outcome", outcome.value)
-    record = rec.finish(
+    nav = NavigationController(build_stack(cfg.navigation, robot, episode), runtime, robot)
+    recorder = Recorder()
+    contacts = _ContactCounter()
+    frames = _Frames(nav) if video else None
+    # recorder and frames first: they keep the first state even when planning fails at once;
+    # the contact counter after the controller: it sees the tick's teleports
+    hooks: list[EpisodeHooks] = [recorder, *([frames] if frames else []), nav, contacts]
+    if realtime:
+        hooks.append(_Pacer())
+    if on_step is not None:
+        hooks.append(_Progress(on_step))
+    runner = EpisodeRunner(backend, dt, hooks, nav)
+    crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
+    runner.reset(episode, crowd, seed)
+    outcome = runner.run()
+    state = runner.state
+    assert state is not None
+    goal = nav.goal or spawn.goal
+    record = recorder.finish(
         EpisodeMeta(
             episode=idx,
             seed=episode.seed,
@@ -423,13 +213,7 @@ def run_episode(
         record = dataclasses.replace(
             record, ped_cf_position=align(record.ped_row, record.ped_id, track)
         )
-    poses = recorder.poses
-    steps = segment_lengths(poses)
-    for row in jumps:  # a teleport is no distance driven
-        if 0 < row <= len(steps):
-            steps[row - 1] = 0.0
-    path_length = float(np.sum(steps))
-    final = poses[-1]
+    final = record.pose[-1]
     result = EpisodeResult(
         index=idx,
         seed=episode.seed,
@@ -439,34 +223,106 @@ def run_episode(
         outcome=outcome.value,
         time=round(state.time, 6),
         steps=state.step,
-        path_length=path_length,
-        collisions=collisions,
+        path_length=path_length_value(record),
+        collisions=contacts.count,
         start=spawn.start.as_array().tolist(),
         goal=goal.as_array().tolist(),
         final_goal_distance=float(math.hypot(goal.x - final[0], goal.y - final[1])),
         wall_time=0.0,
-        error=error,
+        error=runner.error,
         goals_reached=runtime.goals_reached[0],
         teleports=runtime.teleports[0],
         record=record,
     )
-    if control_s:
-        ms = 1e3 * np.array(control_s)
+    if nav.control_s:
+        ms = 1e3 * np.array(nav.control_s)
         result.control_ms_mean = float(ms.mean())
         result.control_ms_p95 = float(np.percentile(ms, 95))
         result.control_ms_max = float(ms.max())
     if out_dir is not None:
         out_dir.mkdir(parents=True, exist_ok=True)
-        result.files.update(recorder.write(out_dir))
+        result.files.update(recorder.write_csv(out_dir))
         result.files["record"] = str(save_record(record, out_dir / "episode.parquet"))
-        if video and states:
+        if frames is not None and frames.states:
             result.files.update(
-                _write_video(cfg, backend, states, views, out_dir, outcome, episode)
+                _write_video(cfg, backend, frames.states, frames.views, out_dir, outcome, episode)
             )
         result.wall_time = time.perf_counter() - t0
         (out_dir / "episode.json").write_text(json.dumps(result.summary(), indent=2))
     result.wall_time = time.perf_counter() - t0
     return result
+
+
+class _ContactCounter(EpisodeHooks):
+    """Counts robot 0's contact events (a contact lasting several steps counts once)."""
+
+    def __init__(self) -> None:
+        self.count, self.touching = 0, False
+
+    def initialize_episode(self, runner: EpisodeRunner) -> None:
+        self.count, self.touching = 0, False
+
+    def before_step(self, runner: EpisodeRunner) -> None:
+        if 0 in runner.teleported:  # a contact where the robot was put is no new event
+            assert runner.state is not None
+            self.touching = bool(runner.state.collisions.any[0])
+
+    def after_step(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        hit = bool(runner.state.collisions.any[0])
+        self.count += hit and not self.touching
+        self.touching = hit
+
+
+class _Pacer(EpisodeHooks):
+    """Paces the episode to ``dt`` of wall time per step (interactive runs)."""
+
+    def initialize_episode(self, runner: EpisodeRunner) -> None:
+        self.wall_start = time.perf_counter()
+
+    def before_step(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        ahead = self.wall_start + runner.state.time + runner.dt - time.perf_counter()
+        if ahead > 0:
+            time.sleep(ahead)
+
+
+class _Progress(EpisodeHooks):
+    """Calls ``on_step(time s, time_limit s)`` after each step (progress displays)."""
+
+    def __init__(self, on_step: Callable[[float, float], None]) -> None:
+        self.on_step = on_step
+
+    def after_step(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        assert runner.episode is not None
+        self.on_step(runner.state.time, runner.episode.time_limit)
+
+
+class _Frames(EpisodeHooks):
+    """Keeps every state and the plan and goal it was driven by, for the video."""
+
+    def __init__(self, nav: NavigationController) -> None:
+        self.nav = nav
+        self.states: list[SimState] = []
+        self.views: list[tuple[NDArray[np.float64], Pose2D]] = []
+
+    def _view(self) -> tuple[NDArray[np.float64], Pose2D]:
+        assert self.nav.goal is not None
+        return self.nav.stack.path, self.nav.goal
+
+    def initialize_episode(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        self.states, self.views = [runner.state], []
+
+    def before_step(self, runner: EpisodeRunner) -> None:
+        if runner.ticks == 0 and not self.views:  # the first plan (none if planning failed)
+            self.views.append(self._view())
+
+    def after_step(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        self.states.append(runner.state)
+        self.views.append(self._view())
 
 
 def _write_video(
