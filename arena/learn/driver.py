@@ -28,6 +28,7 @@ from arena.core.errors import ConfigError, PlanningError, SamplingError, StartOc
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome, Pose2D
 from arena.crowd.simulator import CrowdSimulator
+from arena.episode.runner import EpisodeHooks, EpisodeRunner
 from arena.learn.actions import ActionDecoder
 from arena.learn.config import EnvConfig, SubgoalObsConfig
 from arena.learn.keywords import load_with_keywords
@@ -197,6 +198,17 @@ class SubgoalTracker:
         return np.vstack([start.xy[None, :], path])
 
 
+class _ContactDuringTick(EpisodeHooks):
+    """``any``: ``(r,)`` bool, each robot touched something during the tick's substeps."""
+
+    def __init__(self) -> None:
+        self.any = np.zeros(0, dtype=bool)
+
+    def after_step(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        self.any |= runner.state.collisions.any
+
+
 class EpisodeDriver:
     """``r`` robots of one model in one world, stepped together.
 
@@ -220,6 +232,12 @@ class EpisodeDriver:
         self.decoder = ActionDecoder(self.env_cfg.action, self.robot)
         self.reward_fn = RewardFunction(self.env_cfg.reward)
         self.backend: SimulatorBackend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
+        # the one episode loop, stepped from outside: each env step is one runner tick
+        self._contact = _ContactDuringTick()
+        self.runner = EpisodeRunner(
+            self.backend, self.dt, [self._contact] if self.substeps > 1 else [],
+            substeps=self.substeps,
+        )
         self.seed = cfg.seed
         self.generator = self._generator(self.seed)
         self.next_index = 0
@@ -268,7 +286,7 @@ class EpisodeDriver:
         ep = self.generator.episode(idx)
         self.episode = ep
         crowd = CrowdSimulator.build(self.cfg.crowd, self.cfg.pedestrians)
-        self.state = self.backend.reset(ep, crowd, derive_rng(self.seed, "episode", idx, "sim"))
+        self.state = self.runner.reset(ep, crowd, self.seed)
         self.steps = 0
         self.robot_steps = np.zeros(self.n_robots, dtype=np.int64)
         self._episode_index = idx
@@ -382,7 +400,7 @@ class EpisodeDriver:
         px, py, prev_heading = self.state.robots.poses.tolist()[0]
         prev_dist = self._hypot(gx - px, gy - py)
         if self.substeps == 1:
-            self.state = self.backend.step(cmd, self.dt)
+            self.state = self.runner.advance(cmd)
             self.steps += 1
             # Collisions.any on scalars (the index arrays are >= -1): four item reads instead
             # of four ufunc calls
@@ -483,13 +501,12 @@ class EpisodeDriver:
     def _advance(self, cmd: FloatArray) -> NDArray[np.bool_]:
         """Step the backend for one action period; ``(r,)`` bool, any contact during it."""
         if self.substeps == 1:
-            self.state = self.backend.step(cmd, self.dt)
+            self.state = self.runner.advance(cmd)
             collision = self.state.collisions.any  # a fresh array
         else:
-            collision = np.zeros(self.n_robots, dtype=bool)
-            for _ in range(self.substeps):
-                self.state = self.backend.step(cmd, self.dt)
-                collision |= self.state.collisions.any
+            self._contact.any = np.zeros(self.n_robots, dtype=bool)
+            self.state = self.runner.advance(cmd)
+            collision = self._contact.any
         self.steps += 1
         self.robot_steps += 1
         return collision
@@ -638,7 +655,7 @@ class EpisodeDriver:
             )
         except SamplingError:
             return False
-        self.state = self.backend.teleport(i, start)
+        self.state = self.runner.teleport(i, start)
         self.goals = self.goals.copy()
         self.goals[i] = goal.as_array()
         self.last_action = self.last_action.copy()
