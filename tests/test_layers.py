@@ -4,12 +4,14 @@ Every ``import`` statement under ``arena/`` counts, at module level or inside a 
 function-level import still ties the two modules together), except those under
 ``if TYPE_CHECKING:`` (annotations only). The low layers, lowest first::
 
-    core < scene < maps < sensors < robots < crowd < sim < tasks
+    core < scene < maps < sensors < robots < crowd < sim < tasks < episode
 
 A module of one of them never imports a module of a higher one. ``scene`` (obstacles, the static
 world, snapshots, episodes) sits below ``maps`` because map sources and generators produce placed
 obstacles; it holds a grid and robot models without calling them (typed under TYPE_CHECKING).
-``sensors`` sits below ``robots`` because a robot model carries its sensors' specs. The higher
+``sensors`` sits below ``robots`` because a robot model carries its sensors' specs. ``episode``
+(the one episode loop) sits on top: experiment, eval and learn run their episodes through it.
+The higher
 packages (nav, eval, experiment, learn, render, cli, config, plugins ...) only need to be free of
 cycles.
 """
@@ -22,7 +24,7 @@ from pathlib import Path
 
 ARENA = Path(__file__).resolve().parent.parent / "arena"
 
-LAYERS = ("core", "scene", "maps", "sensors", "robots", "crowd", "sim", "tasks")
+LAYERS = ("core", "scene", "maps", "sensors", "robots", "crowd", "sim", "tasks", "episode")
 """The low layers, lowest first: ``arena.<layer>`` may import only its own and lower layers."""
 
 
