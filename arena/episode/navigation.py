@@ -23,8 +23,8 @@ from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack, NavStatus
 
 if TYPE_CHECKING:
-    from arena.config.schema import NavigationConfig
     from arena.nav.local_planners.base import LocalPlanner
+    from arena.nav.stack import NavigationConfig
     from arena.robots.model import RobotModel
     from arena.scene.episode import Episode
     from arena.tasks.generator import TaskRuntime

@@ -202,6 +202,7 @@ class EpisodeRunner:
             for hook in hooks:
                 hook.after_step(self)
         self.ticks += 1
+        assert self.state is not None
         return self.state
 
     def tick(self) -> bool:
