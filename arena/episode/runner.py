@@ -1,7 +1,7 @@
 """The one episode loop: reset a backend, then tick it with hooks until the episode ends.
 
 :class:`EpisodeRunner` is the tick loop of every path that simulates an episode:
-``arena run`` and ``arena bench`` (:func:`arena.experiment.run_episode`), the value-policy
+``arena run`` and ``arena bench`` (:func:`arena.eval.episodes.run_episode`), the value-policy
 trainer (:mod:`arena.learn.value.train`) and the learning environments'
 :class:`~arena.learn.driver.EpisodeDriver`. What differs between them lives in
 :class:`EpisodeHooks` (in the manner of dm_control's ``Task``), called in a fixed order::

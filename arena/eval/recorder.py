@@ -163,7 +163,7 @@ class Recorder(EpisodeHooks):
     def event(self, time: float, kind: str, detail: str = "") -> None:
         """Note a discrete event at ``time`` (s).
 
-        Kinds used by :func:`arena.experiment.run_episode`: ``goal_reached``, ``new_goal``,
+        Kinds used by :func:`arena.eval.episodes.run_episode`: ``goal_reached``, ``new_goal``,
         ``teleport``, ``reset``, ``outcome`` (detail: the outcome value).
         """
         self.events.append((float(time), kind, detail))
