@@ -38,7 +38,7 @@ from arena.learn.rewards import (
     RewardOutput,
     SingleRewardInput,
 )
-from arena.learn.subgoals import SubgoalTracker
+from arena.learn.subgoals import SubgoalTracker as SubgoalTracker
 from arena.maps.raster import planning_grid
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
