@@ -328,7 +328,8 @@ def run_training_episode(cfg: ExperimentConfig, generator: TaskGenerator,
     stack = build_stack(cfg.navigation, robot, episode, local_planner=planner)
     nav = NavigationController(stack, generator.runtime(episode), robot)
     runner = EpisodeRunner(backend, cfg.sim.dt, [nav, _CrowdNavRewards(logs, robot.radius)], nav)
-    runner.reset(episode, CrowdSimulator.build(cfg.crowd, cfg.pedestrians), cfg.seed)
+    crowd = CrowdSimulator.build(cfg.crowd, cfg.pedestrians)
+    runner.reset(episode, crowd, cfg.seed)
     outcome = runner.run()
     if runner.exception is not None and not isinstance(runner.exception, ArenaError):
         raise runner.exception
