@@ -486,10 +486,8 @@ class EpisodeDriver:
         return (self.steps >= self.env_cfg.max_steps) or self._at_time_limit()
 
     def _at_time_limit(self) -> bool:
-        """The episode's time limit is reached (every robot is truncated)."""
-        assert self.state is not None
-        assert self.episode is not None
-        return bool(self.state.time >= self.episode.time_limit - 1e-9)
+        """The episode's time limit is reached (every robot is truncated): the runner's rule."""
+        return self.runner.at_time_limit()
 
     # -- respawns (multi-robot training) -------------------------------------------------------
     def respawn(self, i: int, min_goal_distance: float, clearance: float) -> bool:
