@@ -16,10 +16,10 @@ from arena.eval.record import EpisodeMeta
 from arena.eval.recorder import Recorder
 from arena.experiment import make_episode, run_episode
 from arena.learn.env import SocialNavEnv
+from arena.learn.planners.crowdnav import ValuePlannerParams
 from arena.learn.value.train import RecordingPlanner, run_training_episode
 from arena.maps.grid import OccupancyGrid
 from arena.nav.local_planners.base import LOCAL_PLANNERS
-from arena.nav.local_planners.crowdnav import ValuePlannerParams
 from arena.robots.presets import load_robot
 from arena.sim.native2d import Native2DBackend
 from arena.tasks.generator import TaskGenerator, TaskRuntime

@@ -70,6 +70,13 @@ from arena.core.types import Outcome
 from arena.crowd.simulator import CrowdSimulator
 from arena.episode.navigation import NavigationController, build_stack
 from arena.episode.runner import EpisodeHooks, EpisodeRunner
+from arena.learn.planners.crowdnav import (
+    CrowdNavPlanner,
+    SarlPlanner,
+    ValuePlanner,
+    ValuePlannerParams,
+    observe,
+)
 from arena.learn.value.network import (
     CADRL_LAYOUT,
     SARL_LAYOUT,
@@ -81,13 +88,6 @@ from arena.learn.value.network import (
 )
 from arena.learn.value.state import PAIR_DIM, SELF_DIM, rotate
 from arena.nav.local_planners.base import KINEMATICS, LOCAL_PLANNERS, LocalObservation, LocalPlanner
-from arena.nav.local_planners.crowdnav import (
-    CrowdNavPlanner,
-    SarlPlanner,
-    ValuePlanner,
-    ValuePlannerParams,
-    observe,
-)
 from arena.robots.presets import load_robot
 from arena.sim.backend import BACKENDS, SimulatorBackend
 from arena.tasks.generator import TaskGenerator
