@@ -118,7 +118,6 @@ class EpisodeDriver:
         self.next_index = 0
         self.episode: Episode | None = None
         self.state: SimState | None = None
-        self.steps = 0
         r = self.n_robots
         # steps since each robot's start (differ from ``steps`` only after a respawn)
         self.robot_steps = np.zeros(r, dtype=np.int64)
@@ -146,6 +145,11 @@ class EpisodeDriver:
         cfg = self.cfg.model_copy(update={"seed": int(seed)})
         return TaskGenerator.from_config(cfg, [self.robot] * self.n_robots)
 
+    @property
+    def steps(self) -> int:
+        """Env steps since the episode's reset (the runner's ticks)."""
+        return self.runner.ticks
+
     # -- episodes ---------------------------------------------------------------------------
     def reset(self, seed: int | None = None, index: int | None = None) -> Obs:
         """Start the next episode (episode 0 of ``seed`` when a seed is given)."""
@@ -162,7 +166,6 @@ class EpisodeDriver:
         self.episode = ep
         crowd = CrowdSimulator.build(self.cfg.crowd, self.cfg.pedestrians)
         self.state = self.runner.reset(ep, crowd, self.seed)
-        self.steps = 0
         self.robot_steps = np.zeros(self.n_robots, dtype=np.int64)
         self._episode_index = idx
         self._respawns = 0
@@ -276,7 +279,6 @@ class EpisodeDriver:
         prev_dist = self._hypot(gx - px, gy - py)
         if self.substeps == 1:
             self.state = self.runner.advance(cmd)
-            self.steps += 1
             # Collisions.any on scalars (the index arrays are >= -1): four item reads instead
             # of four ufunc calls
             hits = self.state.collisions
@@ -382,7 +384,6 @@ class EpisodeDriver:
             self._contact.any = np.zeros(self.n_robots, dtype=bool)
             self.state = self.runner.advance(cmd)
             collision = self._contact.any
-        self.steps += 1
         self.robot_steps += 1
         return collision
 
