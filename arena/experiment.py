@@ -20,116 +20,42 @@ Output layout (``output.dir``)::
 from __future__ import annotations
 
 import csv
-import dataclasses
 import functools
-import json
 import math
-import re
 import time
-import traceback
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field, fields
 from datetime import datetime
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import yaml
-from numpy.typing import NDArray
 
 import arena.plugins  # noqa: F401  (fills the registries)
+from arena.config.names import UNNAMED, run_name
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ArenaError, PlanningError
 from arena.core.files import make_dir
-from arena.core.geometry import segment_lengths
-from arena.core.rng import derive_rng
-from arena.core.types import Outcome, Pose2D
-from arena.crowd.driver import build_driver
-from arena.eval.counterfactual import align, replay_crowd
-from arena.eval.io import save_record
-from arena.eval.record import EpisodeMeta, EpisodeRecord
-from arena.eval.recorder import Recorder
-from arena.maps.raster import planning_grid
-from arena.nav.intermediate.base import Pedestrians
-from arena.nav.local_planners.base import LocalObservation
-from arena.nav.stack import NavigationStack, NavStatus
+from arena.episode.runner import describe_exception
+from arena.eval.episodes import EpisodeResult, episode_metrics, failed_result, run_episode
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.scene.episode import Episode
-from arena.scene.state import SimState
-from arena.sim.backend import BACKENDS, SimulatorBackend
-from arena.tasks.generator import TaskGenerator, TaskRuntime
+from arena.sim.backend import BACKENDS
+from arena.tasks.generator import TaskGenerator
 
-
-@dataclass
-class EpisodeResult:
-    """Figures of one finished episode (robot 0)."""
-
-    index: int
-    seed: int
-    map: str
-    robot: str
-    stage: str
-    outcome: str
-    time: float
-    steps: int
-    path_length: float
-    collisions: int
-    start: list[float]
-    goal: list[float]
-    final_goal_distance: float
-    wall_time: float
-    error: str = ""
-    goals_reached: int = 0
-    teleports: int = 0
-    control_ms_mean: float = 0.0
-    control_ms_p95: float = 0.0
-    control_ms_max: float = 0.0
-    files: dict[str, str] = field(default_factory=dict)
-    #: Every registered metric of the episode (:func:`episode_metrics`), set by
-    #: :func:`run_experiment`; in summary.csv, not in episode.json.
-    metrics: dict[str, float] = field(default_factory=dict, compare=False)
-    #: The full step-by-step record (not part of :meth:`summary`, episode.json or summary.csv;
-    #: on disk it is ``files["record"]``, ``episode.parquet``).
-    record: EpisodeRecord | None = field(default=None, repr=False, compare=False)
-
-    def summary(self) -> dict[str, Any]:
-        """The figures as plain data, as in episode.json (all fields but record, metrics)."""
-        return {
-            f.name: getattr(self, f.name) for f in fields(self)
-            if f.name not in ("record", "metrics")
-        }
-
-
-def describe_exception(e: BaseException) -> str:
-    """One line for a failed episode: ``"<Type>: message"`` (its first line).
-
-    Anything but an :class:`ArenaError` (a plugin's bug) gets ``" (at file.py:line)"``, where it
-    was raised.
-    """
-    lines = str(e).strip().splitlines()
-    text = f"{type(e).__name__}: {lines[0] if lines else ''}".rstrip(": ")
-    if not isinstance(e, ArenaError):
-        tb = traceback.extract_tb(e.__traceback__)
-        if tb:
-            text += f" (at {Path(tb[-1].filename).name}:{tb[-1].lineno})"
-    return text
-
-
-def failed_result(cfg: ExperimentConfig, episode: Episode, error: str,
-                  wall_time: float = 0.0) -> EpisodeResult:
-    """The result of an episode that failed before it could be simulated (outcome ``error``).
-
-    Figures are NaN (time, path length, goal distance) or zero (steps, collisions); no record.
-    """
-    spawn = episode.robots[0]
-    return EpisodeResult(
-        index=episode.index, seed=episode.seed, map=episode.map_name, robot=spawn.model.name,
-        stage=episode.label, outcome=Outcome.ERROR.value, time=math.nan, steps=0,
-        path_length=math.nan, collisions=0, start=spawn.start.as_array().tolist(),
-        goal=spawn.goal.as_array().tolist(), final_goal_distance=math.nan, wall_time=wall_time,
-        error=error,
-    )
+# The experiment API: run_experiment and make_episode here; one episode is arena.eval.episodes,
+# run names arena.config.names.
+__all__ = [
+    "UNNAMED",
+    "EpisodeResult",
+    "default_output_dir",
+    "describe_exception",
+    "episode_metrics",
+    "failed_result",
+    "make_episode",
+    "run_episode",
+    "run_experiment",
+    "run_name",
+]
 
 
 def make_episode(
@@ -147,400 +73,6 @@ def make_episode(
         cfg, [robot] if robot is not None else None
     )
     return generator.episode(index)
-
-
-class EpisodeRecorder:
-    """Collects per-step robot and pedestrian state and writes them as CSV."""
-
-    ROBOT_COLUMNS = (
-        "step",
-        "time",
-        "x",
-        "y",
-        "theta",
-        "vx",
-        "vy",
-        "omega",
-        "cmd_vx",
-        "cmd_vy",
-        "cmd_omega",
-        "min_range",
-        "collision",
-    )
-    AGENT_COLUMNS = (
-        "step",
-        "time",
-        "id",
-        "x",
-        "y",
-        "vx",
-        "vy",
-        "heading",
-        "radius",
-        "kind",
-        "state",
-    )
-
-    def __init__(self) -> None:
-        self.robot_rows: list[np.ndarray] = []
-        self.agent_rows: list[np.ndarray] = []
-
-    def record(self, s: SimState) -> None:
-        """Store robot 0 and every pedestrian at this snapshot."""
-        r = s.robots
-        scan = r.scans[0]
-        min_range = float(scan.min()) if scan.size else math.nan
-        self.robot_rows.append(
-            np.concatenate(
-                [
-                    [s.step, s.time],
-                    r.poses[0],
-                    r.twists[0],
-                    r.commands[0],
-                    [min_range, float(s.collisions.any[0])],
-                ]
-            )
-        )
-        a = s.agents
-        n = len(a)
-        if n:
-            self.agent_rows.append(
-                np.column_stack(
-                    [
-                        np.full(n, s.step),
-                        np.full(n, s.time),
-                        a.ids,
-                        a.positions,
-                        a.velocities,
-                        a.headings,
-                        a.radii,
-                        a.kinds,
-                        a.states,
-                    ]
-                )
-            )
-
-    @property
-    def poses(self) -> np.ndarray:
-        """``(steps, 3)`` robot poses."""
-        return np.array([row[2:5] for row in self.robot_rows])
-
-    def write(self, folder: Path) -> dict[str, str]:
-        """Write ``trajectory.csv`` and ``agents.csv``; return their paths."""
-        traj = folder / "trajectory.csv"
-        _write_csv(traj, self.ROBOT_COLUMNS, np.array(self.robot_rows), int_cols=(0, 12))
-        agents = folder / "agents.csv"
-        rows = np.concatenate(self.agent_rows) if self.agent_rows else np.zeros((0, 11))
-        _write_csv(agents, self.AGENT_COLUMNS, rows, int_cols=(0, 2, 9, 10))
-        return {"trajectory": str(traj), "agents": str(agents)}
-
-
-def _fmt_pose(p: Pose2D) -> str:
-    return f"[{p.x:.3f}, {p.y:.3f}, {p.theta:.3f}]"
-
-
-def _write_csv(
-    path: Path, header: tuple[str, ...], rows: np.ndarray, int_cols: tuple[int, ...]
-) -> None:
-    with path.open("w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(header)
-        for row in rows:
-            w.writerow([int(v) if i in int_cols else f"{v:.6g}" for i, v in enumerate(row)])
-
-
-def run_episode(
-    cfg: ExperimentConfig,
-    episode: Episode,
-    backend: SimulatorBackend,
-    out_dir: Path | None,
-    *,
-    video: bool = False,
-    runtime: TaskRuntime | None = None,
-    realtime: bool = False,
-    on_step: Callable[[float, float], None] | None = None,
-) -> EpisodeResult:
-    """Simulate one episode with the configured navigation stack and write its files.
-
-    ``runtime`` decides when goals are reached and what comes next (the generator's
-    :meth:`~arena.tasks.generator.TaskGenerator.runtime`); by default each robot is done when it
-    reaches its goal. Every step its update is applied: teleports move the robot (backend
-    ``teleport``, the stack plans afresh), new goals make the stack replan, and a forced reset
-    ends the episode as ``aborted``. ``realtime`` paces the loop to ``dt`` of wall time per
-    step (interactive runs). ``on_step(time, time_limit)`` (both s) is called after each
-    simulated step (progress displays).
-
-    The stack's goal tolerances follow the episode: position within ``0.9 · goal_radius`` (or
-    the navigation config's, if smaller) and, when the task checks the heading
-    (``goal_tolerance_angle``), the heading too; robots that can turn on the spot then align
-    their heading at the goal. Car-like (Ackermann) robots cannot, so a heading tolerance is
-    met by them only when the approach ends with it.
-
-    When the stack reports ``STUCK`` (oscillation detected and every recovery behaviour of
-    ``navigation.recovery_behaviors`` tried, see :mod:`arena.nav.recovery`), the episode ends
-    at once as ``stuck``.
-    """
-    if runtime is None:
-        runtime = TaskRuntime.single_goal(episode)
-    t0 = time.perf_counter()
-    spawn = episode.robots[0]
-    robot = spawn.model
-    seed, idx = cfg.seed, episode.index
-    crowd = build_driver(cfg.crowd, cfg.pedestrians)
-    state = backend.reset(episode, crowd, derive_rng(seed, "episode", idx, "sim"))
-    stack = NavigationStack.from_config(
-        cfg.navigation, robot_radius=robot.radius,
-        footprint_radius=robot.inscribed_radius or None,  # narrow passages: the body fits
-    )
-    stack.scan_range_max = float(robot.laser.range_max)
-    stack.goal_tolerance_xy = min(stack.goal_tolerance_xy, 0.9 * episode.goal_radius)
-    if episode.goal_tolerance_angle is not None:
-        stack.goal_tolerance_yaw = float(episode.goal_tolerance_angle)
-    limits = robot.limits()
-    laser = robot.laser
-    angles = laser.angles() + laser.mount[2]
-    scan_origin = np.array(laser.mount[:2])
-    dt = cfg.sim.dt
-    goal = spawn.goal
-
-    recorder = EpisodeRecorder()
-    rec = Recorder()
-    control_s: list[float] = []  # wall time of each navigation-stack call (global+inter+local)
-    recorder.record(state)
-    rec.record(state)
-    states = [state] if video else []
-    # per recorded state the plan and goal it was driven by, so a video shows each at its time
-    views: list[tuple[NDArray[np.float64], Pose2D]] = []
-    outcome, error = Outcome.TIMEOUT, ""
-    collisions, touching = 0, False
-    jumps: list[int] = []  # recorder rows reached by a teleport (not driven)
-    wall_start = time.perf_counter()
-    try:
-        stack.reset(planning_grid(episode), spawn.start, goal)
-        if video:
-            views.append((stack.path, goal))
-        while True:
-            update = runtime.update(state.time, state.robots.poses, state.agents.positions)
-            if 0 in update.reached:
-                rec.event(state.time, "goal_reached", "robot 0")
-            if update.reset:
-                rec.event(state.time, "reset", "forced reset")
-                outcome = Outcome.ABORTED
-                break
-            if update.done:
-                outcome = Outcome.SUCCESS
-                break
-            for i, target in sorted(update.teleports.items()):
-                state = backend.teleport(i, target)
-                if i == 0:
-                    jumps.append(len(recorder.robot_rows))
-                    touching = bool(state.collisions.any[0])
-                    rec.event(state.time, "teleport", f"robot 0 to {_fmt_pose(target)}")
-            if 0 in update.goals:
-                goal = update.goals[0]
-                rec.event(state.time, "new_goal", f"robot 0 to {_fmt_pose(goal)}")
-            if 0 in update.goals or 0 in update.teleports:
-                stack.reset(
-                    planning_grid(episode), Pose2D.from_array(state.robots.poses[0]), goal,
-                    time=state.time,
-                )
-            pose = state.robots.poses[0]
-            if state.time >= episode.time_limit - 1e-9:
-                outcome = Outcome.TIMEOUT
-                break
-            obs = LocalObservation(
-                pose=pose,
-                twist=state.robots.twists[0],
-                goal=goal,
-                path=stack.path,
-                limits=limits,
-                robot_radius=robot.radius,
-                dt=dt,
-                scan_ranges=state.robots.scans[0],
-                scan_angles=angles,
-                scan_origin=scan_origin,
-                time=state.time,
-                kinematics=robot.kinematics_type,
-            )
-            agents = state.agents
-            peds = Pedestrians(
-                positions=agents.positions, velocities=agents.velocities,
-                kinds=agents.kinds, states=agents.states,
-            )
-            t_ctl = time.perf_counter()
-            cmd = np.asarray(stack.step(obs, peds), dtype=np.float64)
-            control_s.append(time.perf_counter() - t_ctl)
-            if stack.status is NavStatus.STUCK:  # every recovery behaviour failed
-                outcome = Outcome.STUCK
-                break
-            if cmd.shape != (3,) or not np.all(np.isfinite(cmd)):
-                raise ArenaError(f"the navigation stack returned an invalid command {cmd!r}")
-            if realtime:
-                ahead = wall_start + state.time + dt - time.perf_counter()
-                if ahead > 0:
-                    time.sleep(ahead)
-            state = backend.step(cmd[None, :], dt)
-            if on_step is not None:
-                on_step(state.time, episode.time_limit)
-            recorder.record(state)
-            rec.record(state)
-            if video:
-                states.append(state)
-                views.append((stack.path, goal))
-            hit = bool(state.collisions.any[0])
-            collisions += hit and not touching  # count contact events, not contact steps
-            touching = hit
-    except PlanningError as e:
-        outcome, error = Outcome.PLANNER_FAILURE, f"{type(e).__name__}: {e}"
-    except Exception as e:  # a faulty plugin (any exception) costs this episode, not the run
-        outcome, error = Outcome.ERROR, describe_exception(e)
-
-    rec.event(state.time, "outcome", outcome.value)
-    record = rec.finish(
-        EpisodeMeta(
-            episode=idx,
-            seed=episode.seed,
-            stage=episode.label,
-            map_name=episode.map_name,
-            robot=robot.name,
-            robot_radius=float(robot.radius),
-            start=spawn.start.as_array(),
-            goal=goal.as_array(),
-            goal_radius=float(episode.goal_radius),
-            goal_tolerance_angle=episode.goal_tolerance_angle,
-            time_limit=float(episode.time_limit),
-            dt=float(dt),
-            outcome=outcome.value,
-            config=cfg.model_dump(mode="json"),
-        )
-    )
-    if cfg.evaluation.counterfactual and len(episode.agents):
-        # The same crowd without the robot, from the stream the backend gave the pedestrians.
-        track = replay_crowd(
-            cfg.crowd, cfg.pedestrians, episode, state.step, dt,
-            derive_rng(seed, "episode", idx, "sim"),
-        )
-        record = dataclasses.replace(
-            record, ped_cf_position=align(record.ped_row, record.ped_id, track)
-        )
-    poses = recorder.poses
-    steps = segment_lengths(poses)
-    for row in jumps:  # a teleport is no distance driven
-        if 0 < row <= len(steps):
-            steps[row - 1] = 0.0
-    path_length = float(np.sum(steps))
-    final = poses[-1]
-    result = EpisodeResult(
-        index=idx,
-        seed=episode.seed,
-        map=episode.map_name,
-        robot=robot.name,
-        stage=episode.label,
-        outcome=outcome.value,
-        time=round(state.time, 6),
-        steps=state.step,
-        path_length=path_length,
-        collisions=collisions,
-        start=spawn.start.as_array().tolist(),
-        goal=goal.as_array().tolist(),
-        final_goal_distance=float(math.hypot(goal.x - final[0], goal.y - final[1])),
-        wall_time=0.0,
-        error=error,
-        goals_reached=runtime.goals_reached[0],
-        teleports=runtime.teleports[0],
-        record=record,
-    )
-    if control_s:
-        ms = 1e3 * np.array(control_s)
-        result.control_ms_mean = float(ms.mean())
-        result.control_ms_p95 = float(np.percentile(ms, 95))
-        result.control_ms_max = float(ms.max())
-    if out_dir is not None:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        result.files.update(recorder.write(out_dir))
-        result.files["record"] = str(save_record(record, out_dir / "episode.parquet"))
-        if video and states:
-            result.files.update(
-                _write_video(cfg, backend, states, views, out_dir, outcome, episode)
-            )
-        result.wall_time = time.perf_counter() - t0
-        (out_dir / "episode.json").write_text(json.dumps(result.summary(), indent=2))
-    result.wall_time = time.perf_counter() - t0
-    return result
-
-
-def _write_video(
-    cfg, backend, states, views, out_dir: Path, outcome: Outcome, episode: Episode
-) -> dict[str, str]:
-    """The episode's video and its last frame; ``views[k]`` is state ``k``'s (plan, goal)."""
-    # Imported here: rendering is optional and the only user of matplotlib.
-    from arena.render import FrameRenderer, Overlay, VideoWriter, legend_items, save_png
-
-    last = len(states) - 1
-    drawn = [k for k in range(len(states)) if k % cfg.output.frame_every == 0 or k == last]
-    overlays = []
-    for k in drawn:
-        # no plan yet where planning failed at the start: the goal alone
-        path, goal = views[k] if k < len(views) else (None, episode.robots[0].goal)
-        text = f"t = {states[k].time:5.1f} s   step {states[k].step}"
-        overlays.append(Overlay(paths=[path], goals=goal.as_array()[None, :],
-                                text=text + (f"   {outcome.value}" if k == last else "")))
-    robot_specs = [spawn.model.laser for spawn in episode.robots]
-    renderer = FrameRenderer(
-        backend.world,
-        lidar_specs=robot_specs,
-        width_px=cfg.output.width_px,
-        title=" · ".join(
-            t for t in (run_name(cfg), episode.label, states[0].robots.models[0], cfg.crowd["type"])
-            if t
-        ),
-        # a key to exactly what the video shows (its social states, a collision if one happens)
-        legend=legend_items(
-            [states[k] for k in drawn], overlays,
-            lidar=any(spec is not None for spec in robot_specs), trails=True,
-        ),
-    )
-    video_path = out_dir / f"video.{cfg.output.video_format}"
-    fps = 1.0 / cfg.sim.dt / cfg.output.frame_every
-    frame = None
-    with VideoWriter(video_path, fps=fps) as writer:
-        for k, ov in zip(drawn, overlays, strict=True):
-            frame = renderer.render(states[k], ov)
-            writer.append(frame)
-    files = {"video": str(video_path)}
-    if frame is not None:
-        png = out_dir / "final.png"
-        save_png(frame, png)
-        files["final_frame"] = str(png)
-    return files
-
-
-#: ``ExperimentConfig.name``'s default: a run left unnamed is named after what it runs.
-UNNAMED = ExperimentConfig.model_fields["name"].default
-
-
-def run_name(cfg: ExperimentConfig) -> str:
-    """The run's label: ``cfg.name``, or ``<map>_<robot>_<local planner>`` when it is unnamed.
-
-    Unnamed is the schema default (``name: default`` or no ``name`` key): then the map (world
-    name, map file's world folder or stem, or generator type), the robot preset (or robot file
-    stem) and the local planner name the run, e.g. ``small_office_jackal_pure_pursuit``.
-    """
-    if cfg.name != UNNAMED:
-        return cfg.name
-    spec = cfg.map
-    if spec.get("type") == "world" and spec.get("name"):
-        where = Path(str(spec["name"])).name
-    elif spec.get("type") == "file" and spec.get("path"):
-        path = Path(str(spec["path"]))
-        where = path.parent.parent.name if path.parent.name == "map" else path.stem
-    else:
-        where = str(spec.get("type", "map"))
-    robot = Path(cfg.robot).stem if cfg.robot.endswith((".yaml", ".yml")) else cfg.robot
-    local = str(cfg.navigation.local_planner.get("type", "planner"))
-    # only characters that are safe in a folder name on every system
-    return "_".join(re.sub(r"[^A-Za-z0-9_.-]+", "-", p).strip("-.")[:40] or "x"
-                    for p in (where, robot, local))
 
 
 def default_output_dir(cfg: ExperimentConfig) -> Path:
@@ -611,25 +143,6 @@ def run_experiment(
     if not results:
         _write_summary(out / "summary.csv", results)
     return out, results
-
-
-def episode_metrics(record: EpisodeRecord | None) -> tuple[dict[str, float], str]:
-    """Every registered metric of one episode (what ``arena bench`` stores per episode).
-
-    Returns:
-        ``{metric: value}`` (NaN where undefined; all NaN without a record or when a metric
-        raises, so that a faulty metric plugin costs its figures, not the run) and ``""``, or
-        that error as ``"metrics: <Type>: message"``.
-    """
-    from arena.eval.metrics import METRICS, compute_metrics
-
-    if record is not None:
-        try:
-            return compute_metrics(record), ""
-        except Exception as e:
-            nan = {n: math.nan for n in METRICS.names()}
-            return nan, f"metrics: {type(e).__name__}: {e}"
-    return {n: math.nan for n in METRICS.names()}, ""
 
 
 def _write_summary(path: Path, results: list[EpisodeResult]) -> None:

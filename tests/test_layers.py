@@ -4,14 +4,17 @@ Every ``import`` statement under ``arena/`` counts, at module level or inside a 
 function-level import still ties the two modules together), except those under
 ``if TYPE_CHECKING:`` (annotations only). The low layers, lowest first::
 
-    core < scene < maps < sensors < robots < crowd < sim < tasks
+    core < scene < maps < sensors < robots < crowd < sim < tasks < episode
 
 A module of one of them never imports a module of a higher one. ``scene`` (obstacles, the static
 world, snapshots, episodes) sits below ``maps`` because map sources and generators produce placed
 obstacles; it holds a grid and robot models without calling them (typed under TYPE_CHECKING).
-``sensors`` sits below ``robots`` because a robot model carries its sensors' specs. The higher
-packages (nav, eval, experiment, learn, render, cli, config, plugins ...) only need to be free of
-cycles.
+``sensors`` sits below ``robots`` because a robot model carries its sensors' specs. ``episode``
+(the one episode loop) sits on top: experiment, eval and learn run their episodes through it.
+The higher
+packages (nav, eval, experiment, learn, render, cli, config, plugins ...) need to be free of
+cycles, and the pairs of :data:`UPWARD` (nav below learn, eval below experiment, the episode
+loop below eval, learn and experiment) never import upward.
 """
 
 from __future__ import annotations
@@ -22,7 +25,7 @@ from pathlib import Path
 
 ARENA = Path(__file__).resolve().parent.parent / "arena"
 
-LAYERS = ("core", "scene", "maps", "sensors", "robots", "crowd", "sim", "tasks")
+LAYERS = ("core", "scene", "maps", "sensors", "robots", "crowd", "sim", "tasks", "episode")
 """The low layers, lowest first: ``arena.<layer>`` may import only its own and lower layers."""
 
 
@@ -141,3 +144,29 @@ def test_the_checks_catch_a_cycle_and_an_upward_import():
         pass
     else:
         raise AssertionError("graphlib did not report a cycle")
+
+
+UPWARD = {
+    ("nav", "learn"),  # the learned planners live in arena.learn.planners
+    ("eval", "experiment"),  # one benchmark episode is arena.eval.episodes
+    ("episode", "eval"), ("episode", "learn"), ("episode", "experiment"),  # the loop is below
+}
+"""Package pairs ``(a, b)``: no module of ``arena.a`` imports one of ``arena.b``."""
+
+
+def test_the_loop_and_navigation_sit_below_learn_eval_and_experiment():
+    def package(module: str) -> str:
+        parts = module.split(".")
+        return parts[1] if len(parts) > 1 else parts[0]
+
+    wrong = [
+        f"{module}:{line} imports {target}"
+        for module, deps in GRAPH.items()
+        for target, line in deps
+        if (package(module), package(target)) in UPWARD
+    ]
+    assert wrong == []
+    # the pairs are read: each upper package does import the lower one
+    assert any(package(t) == "nav" for m, d in GRAPH.items() if package(m) == "learn" for t, _ in d)
+    assert any(package(t) == "episode" for m, d in GRAPH.items() if package(m) == "eval"
+               for t, _ in d)

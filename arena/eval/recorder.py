@@ -4,15 +4,23 @@ The :class:`Recorder` keeps robot 0 (one row per recorded state) and every pedes
 arrays appended per step, long format) in growing numpy buffers: capacity doubles when full, so
 recording is amortised O(1) per step with no per-agent Python loop. Events (goal reached, new
 goal, teleport, outcome) are kept as ``(time s, kind, detail)`` tuples.
+
+It is the one recorder of an episode: a hook of :class:`~arena.episode.runner.EpisodeRunner`
+(it records the state after the reset and after every step, and takes the runner's events at
+the episode's end), whose record the metrics read and which also writes the episode's
+``trajectory.csv`` and ``agents.csv`` (:meth:`Recorder.write_csv`).
 """
 
 from __future__ import annotations
 
+import csv
 import math
+from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
 
+from arena.episode.runner import EpisodeHooks, EpisodeRunner
 from arena.eval.record import EpisodeMeta, EpisodeRecord
 from arena.scene.state import SimState
 
@@ -26,6 +34,27 @@ _PED_F = 6
 _PED_I = 4
 
 
+ROBOT_COLUMNS = (
+    "step", "time", "x", "y", "theta", "vx", "vy", "omega", "cmd_vx", "cmd_vy", "cmd_omega",
+    "min_range", "collision",
+)
+"""Columns of ``trajectory.csv``."""
+AGENT_COLUMNS = (
+    "step", "time", "id", "x", "y", "vx", "vy", "heading", "radius", "kind", "state",
+)
+"""Columns of ``agents.csv``."""
+
+
+def _write_csv(
+    path: Path, header: tuple[str, ...], rows: np.ndarray, int_cols: tuple[int, ...]
+) -> None:
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        for row in rows:
+            w.writerow([int(v) if i in int_cols else f"{v:.6g}" for i, v in enumerate(row)])
+
+
 def _grow(buf: np.ndarray, need: int) -> np.ndarray:
     """``buf`` with at least ``need`` rows (capacity doubled), old rows kept."""
     if need <= buf.shape[0]:
@@ -36,7 +65,7 @@ def _grow(buf: np.ndarray, need: int) -> np.ndarray:
     return out
 
 
-class Recorder:
+class Recorder(EpisodeHooks):
     """Records robot 0 and all pedestrians at every simulation step.
 
     Call :meth:`record` with the state after ``reset`` and after every ``step`` (and, if wanted,
@@ -53,7 +82,9 @@ class Recorder:
         self._n = 0
         self._k = 0
         self._robot = np.empty((capacity, _ROBOT_F), dtype=np.float64)
-        self._coll = np.empty((capacity, 4), dtype=np.bool_)  # wall, obstacle, ped, robot
+        # wall, obstacle, pedestrian, robot contact; no laser beams (min_range undefined)
+        self._coll = np.empty((capacity, 5), dtype=np.bool_)
+        self._step = np.empty(capacity, dtype=np.int64)
         self._ped_f = np.empty((capacity * 4, _PED_F), dtype=np.float64)
         self._ped_i = np.empty((capacity * 4, _PED_I), dtype=np.int64)
         self._scans: np.ndarray | None = None
@@ -75,6 +106,8 @@ class Recorder:
         n = self._n
         self._robot = _grow(self._robot, n + 1)
         self._coll = _grow(self._coll, n + 1)
+        self._step = _grow(self._step, n + 1)
+        self._step[n] = state.step
         scan = r.scans[0]
         min_range = float(scan.min()) if scan.size else math.inf
         cmd = r.commands[0] if command is None else np.asarray(command, dtype=np.float64)
@@ -86,7 +119,7 @@ class Recorder:
         row[10] = min_range
         c = state.collisions
         self._coll[n] = (
-            bool(c.wall[0]), c.obstacle[0] >= 0, c.agent[0] >= 0, c.robot[0] >= 0
+            bool(c.wall[0]), c.obstacle[0] >= 0, c.agent[0] >= 0, c.robot[0] >= 0, not scan.size
         )
         if self.keep_scans:
             if self._scans is None:
@@ -112,10 +145,25 @@ class Recorder:
             self._k = k + m
         self._n = n + 1
 
+    # -- as a hook of the episode runner -------------------------------------------------------
+    def initialize_episode(self, runner: EpisodeRunner) -> None:
+        """Record the state after the reset."""
+        assert runner.state is not None
+        self.record(runner.state)
+
+    def after_step(self, runner: EpisodeRunner) -> None:
+        """Record the state after the step."""
+        assert runner.state is not None
+        self.record(runner.state)
+
+    def episode_end(self, runner: EpisodeRunner) -> None:
+        """Take the episode's events (the runner's, in order)."""
+        self.events.extend(runner.events)
+
     def event(self, time: float, kind: str, detail: str = "") -> None:
         """Note a discrete event at ``time`` (s).
 
-        Kinds used by :func:`arena.experiment.run_episode`: ``goal_reached``, ``new_goal``,
+        Kinds used by :func:`arena.eval.episodes.run_episode`: ``goal_reached``, ``new_goal``,
         ``teleport``, ``reset``, ``outcome`` (detail: the outcome value).
         """
         self.events.append((float(time), kind, detail))
@@ -129,6 +177,31 @@ class Recorder:
     def scans(self) -> FloatArray | None:
         """``(T, beams)`` robot 0's laser ranges (m), or ``None`` unless ``keep_scans``."""
         return None if self._scans is None else self._scans[: self._n].copy()
+
+    def write_csv(self, folder: Path) -> dict[str, str]:
+        """Write ``trajectory.csv`` (robot 0 per row) and ``agents.csv`` (long format).
+
+        ``trajectory.csv``: ``step, time, x, y, theta, vx, vy, omega, cmd_vx, cmd_vy,
+        cmd_omega, min_range, collision`` (``min_range`` NaN without beams, ``collision`` 0/1);
+        ``agents.csv``: ``step, time, id, x, y, vx, vy, heading, radius, kind, state``. Floats
+        with 6 significant digits. Returns ``{"trajectory": path, "agents": path}``.
+        """
+        n, k = self._n, self._k
+        rb, co = self._robot[:n], self._coll[:n]
+        robot = np.column_stack([
+            self._step[:n], rb[:, :10], np.where(co[:, 4], math.nan, rb[:, 10]),
+            co[:, :4].any(axis=1),
+        ])
+        traj = folder / "trajectory.csv"
+        _write_csv(traj, ROBOT_COLUMNS, robot, int_cols=(0, 12))
+        pi, pf = self._ped_i[:k], self._ped_f[:k]
+        rows = pi[:, 0]
+        agents_rows = np.column_stack([
+            self._step[rows], rb[rows, 0], pi[:, 1], pf[:, 0:5], pf[:, 5], pi[:, 2], pi[:, 3],
+        ]) if k else np.zeros((0, 11))
+        agents = folder / "agents.csv"
+        _write_csv(agents, AGENT_COLUMNS, agents_rows, int_cols=(0, 2, 9, 10))
+        return {"trajectory": str(traj), "agents": str(agents)}
 
     def finish(self, meta: EpisodeMeta) -> EpisodeRecord:
         """The record of everything recorded so far (arrays are copies)."""

@@ -81,7 +81,7 @@ def render_episode_video(
     """
     import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
     from arena.config.schema import ExperimentConfig
-    from arena.experiment import run_episode
+    from arena.eval.episodes import run_episode
     from arena.robots.presets import load_robot
     from arena.sim.backend import BACKENDS
     from arena.tasks.generator import TaskGenerator

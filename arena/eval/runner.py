@@ -7,7 +7,7 @@ commits each finished job to the run's :mod:`results store <arena.eval.store>`, 
 job, so the results do not depend on the number of workers, and a killed run resumes where it
 stopped (``resume=True`` skips the committed jobs).
 
-Metrics named like a figure of :class:`~arena.experiment.EpisodeResult` (``path_length``,
+Metrics named like a figure of :class:`~arena.eval.episodes.EpisodeResult` (``path_length``,
 ``collisions``) are stored once, as the figure (``collisions`` an int; ``path_length`` without
 teleport jumps, as the metric, which finds them by the record's ``teleport`` events).
 
@@ -120,7 +120,7 @@ def _generator(config_json: str) -> Any:
 
 
 def _nan_metrics() -> dict[str, float]:
-    from arena.experiment import episode_metrics
+    from arena.eval.episodes import episode_metrics
 
     return episode_metrics(None)[0]
 
@@ -163,7 +163,8 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
     import json
 
     import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
-    from arena.experiment import describe_exception, episode_metrics, run_episode
+    from arena.episode.runner import describe_exception
+    from arena.eval.episodes import episode_metrics, run_episode
     from arena.sim.backend import BACKENDS
 
     t0 = time.perf_counter()
@@ -194,8 +195,8 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
 
 def _warm_up() -> None:
     """A fresh worker's imports (registries, simulator, metrics), before its first job."""
+    import arena.eval.episodes
     import arena.eval.metrics
-    import arena.experiment
     import arena.plugins  # noqa: F401
 
 

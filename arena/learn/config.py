@@ -31,6 +31,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator
 
+from arena.core.errors import ConfigError
 from arena.learn.train_config import PPOConfig, TrainConfig
 
 SemanticChannel = Literal[
@@ -159,3 +160,16 @@ class LearningConfig(_Strict):
     env: EnvConfig = Field(default_factory=EnvConfig)
     ppo: PPOConfig = Field(default_factory=PPOConfig, description="PPO (arena train)")
     train: TrainConfig = Field(default_factory=TrainConfig, description="arena train run")
+
+
+def substeps(env: EnvConfig, dt: float) -> int:
+    """Simulation steps per env step; ``action_period`` must be a multiple of ``dt``."""
+    if env.action_period is None:
+        return 1
+    k = env.action_period / dt
+    if round(k) < 1 or abs(k - round(k)) > 1e-6:
+        raise ConfigError(
+            f"{env.action_period} s is not a positive multiple of sim.dt = {dt} s",
+            path="learning.env.action_period",
+        )
+    return round(k)

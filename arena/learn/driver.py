@@ -13,26 +13,24 @@ a benchmark episode with the same seed and index share map, starts, goals and cr
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import ndimage
 
 import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ConfigError, PlanningError, SamplingError, StartOccupied
+from arena.core.errors import SamplingError
 from arena.core.rng import derive_rng
-from arena.core.types import Outcome, Pose2D
+from arena.core.types import Outcome
 from arena.crowd.driver import build_driver
+from arena.episode.runner import EpisodeHooks, EpisodeRunner
 from arena.learn.actions import ActionDecoder
-from arena.learn.config import EnvConfig, SubgoalObsConfig
-from arena.learn.keywords import load_with_keywords
+from arena.learn.config import substeps as substeps
+from arena.learn.keywords import ConfigLike as ConfigLike
+from arena.learn.keywords import resolve_config as resolve_config
 from arena.learn.observations import Obs, ObservationBuilder, ObsInput
-from arena.learn.paths import project_on_path, subgoal_on_path
 from arena.learn.rewards import (
     DoneReason,
     RewardFunction,
@@ -40,8 +38,8 @@ from arena.learn.rewards import (
     RewardOutput,
     SingleRewardInput,
 )
+from arena.learn.subgoals import SubgoalTracker as SubgoalTracker
 from arena.maps.raster import planning_grid
-from arena.nav.global_planners.astar import AStarPlanner
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.scene.episode import Episode
@@ -52,51 +50,7 @@ from arena.tasks.robot_modes.random import sample_start_goal, spawn_radius
 from arena.tasks.world import WorldSampler
 
 FloatArray = NDArray[np.float64]
-
-ConfigLike = ExperimentConfig | str | Path | None
-
-
-def resolve_config(
-    config: ConfigLike,
-    overrides: Sequence[str] = (),
-    keywords: Mapping[str, Any] | None = None,
-    *,
-    owner: str = "SocialNavEnv",
-) -> ExperimentConfig:
-    """An :class:`ExperimentConfig` from a config, a YAML path (+ overrides) or ``None``.
-
-    Args:
-        config: a built config, a YAML path or ``None`` (the packaged default).
-        overrides: ``key.path=value`` strings, applied to the YAML.
-        keywords: top-level config keys given as keyword arguments, applied after
-            ``overrides`` (see :func:`~arena.learn.keywords.load_with_keywords`).
-        owner: the class named in error messages.
-
-    Raises:
-        ConfigError: an invalid config, override or keyword, in one line.
-    """
-    if isinstance(config, ExperimentConfig):
-        if overrides or keywords:
-            raise ConfigError(
-                f"{owner}: overrides and config keywords apply to a YAML path or None, "
-                "not to a built ExperimentConfig (use cfg.model_copy(update=...))"
-            )
-        return config
-    return load_with_keywords(config, overrides, keywords or {}, owner)
-
-
-def substeps(env: EnvConfig, dt: float) -> int:
-    """Simulation steps per env step; ``action_period`` must be a multiple of ``dt``."""
-    if env.action_period is None:
-        return 1
-    k = env.action_period / dt
-    if round(k) < 1 or abs(k - round(k)) > 1e-6:
-        raise ConfigError(
-            f"{env.action_period} s is not a positive multiple of sim.dt = {dt} s",
-            path="learning.env.action_period",
-        )
-    return round(k)
-
+# substeps, ConfigLike, resolve_config and SubgoalTracker are also imported from here (envs)
 
 @dataclass(frozen=True, eq=False)
 class StepResult:
@@ -119,82 +73,15 @@ _OUT_COLLISION = Outcome.COLLISION.value
 _OUT_TIMEOUT = Outcome.TIMEOUT.value
 
 
-class SubgoalTracker:
-    """Global paths and subgoals of ``r`` robots (Arena's "spacial horizon", arena_specs §8.1).
+class _ContactDuringTick(EpisodeHooks):
+    """``any``: ``(r,)`` bool, each robot touched something during the tick's substeps."""
 
-    At :meth:`reset` the planning grid is inflated by ``inscribed`` m (robot radius +
-    ``navigation.inflation_margin``, as the navigation stack does) and an A* path planned per
-    robot; :meth:`update` replans every ``replan_period`` s and whenever a robot is more than
-    ``max_deviation`` m from its path, then moves each subgoal to
-    :func:`~arena.learn.paths.subgoal_on_path`. A robot whose start lies in the
-    inflated zone plans from the nearest free cell (its position prepended); when no path exists
-    the straight segment to the goal stands in, so an episode never fails for want of a plan.
-    """
+    def __init__(self) -> None:
+        self.any = np.zeros(0, dtype=bool)
 
-    def __init__(self, cfg: SubgoalObsConfig, inscribed: float, n_robots: int) -> None:
-        self.cfg = cfg
-        self.inscribed = float(inscribed)
-        self.planner = AStarPlanner()
-        self.paths: list[FloatArray] = [np.zeros((1, 2))] * n_robots
-        self.current = np.zeros((n_robots, 2))
-        self.plan_time = np.zeros(n_robots)
-        self.grid: Any = None
-        self._nearest: Any = None
-
-    def reset(self, grid: Any, poses: FloatArray, goals: FloatArray, time: float) -> None:
-        """Inflate ``grid`` and plan from each pose to its goal."""
-        self.grid = grid
-        self.inflated = grid.inflate(self.inscribed)
-        self._nearest = None
-        for i in range(poses.shape[0]):
-            self._replan(i, poses[i], goals[i], time)
-        self._subgoals(poses, goals)
-
-    def update(self, poses: FloatArray, goals: FloatArray, time: float) -> None:
-        """Replan where due or strayed; move the subgoals."""
-        for i in range(poses.shape[0]):
-            due = time - self.plan_time[i] >= self.cfg.replan_period - 1e-9
-            if due or project_on_path(self.paths[i], poses[i, :2])[1] > self.cfg.max_deviation:
-                self._replan(i, poses[i], goals[i], time)
-        self._subgoals(poses, goals)
-
-    def restart(self, i: int, pose: FloatArray, goal: FloatArray, time: float) -> None:
-        """Plan robot ``i`` afresh (a new start or goal) and place its subgoal."""
-        self._replan(i, pose, goal, time)
-        self.current[i] = subgoal_on_path(self.paths[i], pose[:2], self.cfg.horizon)
-
-    def _subgoals(self, poses: FloatArray, goals: FloatArray) -> None:
-        for i in range(poses.shape[0]):
-            self.current[i] = subgoal_on_path(self.paths[i], poses[i, :2], self.cfg.horizon)
-
-    def _replan(self, i: int, pose: FloatArray, goal: FloatArray, time: float) -> None:
-        self.plan_time[i] = time
-        start = Pose2D(float(pose[0]), float(pose[1]), float(pose[2]))
-        end = Pose2D(float(goal[0]), float(goal[1]), 0.0)
-        path: FloatArray | None
-        try:
-            path = self.planner.plan(self.inflated, start, end)
-        except StartOccupied:
-            path = self._plan_via_free_cell(start, end)
-        except PlanningError:
-            path = None
-        if path is None:
-            path = np.array([pose[:2], goal[:2]], dtype=np.float64)
-        self.paths[i] = np.asarray(path, dtype=np.float64)
-
-    def _plan_via_free_cell(self, start: Pose2D, end: Pose2D) -> FloatArray | None:
-        grid = self.inflated
-        cell = grid.world_to_cell(start.xy)
-        if not bool(grid.in_bounds(cell)) or bool(grid.occupied.all()):
-            return None
-        if self._nearest is None:
-            self._nearest = ndimage.distance_transform_edt(grid.occupied, return_indices=True)[1]
-        free = grid.cell_to_world(self._nearest[:, int(cell[0]), int(cell[1])])
-        try:
-            path = self.planner.plan(grid, Pose2D(float(free[0]), float(free[1]), 0.0), end)
-        except PlanningError:
-            return None
-        return np.vstack([start.xy[None, :], path])
+    def after_step(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        self.any |= runner.state.collisions.any
 
 
 class EpisodeDriver:
@@ -220,12 +107,17 @@ class EpisodeDriver:
         self.decoder = ActionDecoder(self.env_cfg.action, self.robot)
         self.reward_fn = RewardFunction(self.env_cfg.reward)
         self.backend: SimulatorBackend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
+        # the one episode loop, stepped from outside: each env step is one runner tick
+        self._contact = _ContactDuringTick()
+        self.runner = EpisodeRunner(
+            self.backend, self.dt, [self._contact] if self.substeps > 1 else [],
+            substeps=self.substeps,
+        )
         self.seed = cfg.seed
         self.generator = self._generator(self.seed)
         self.next_index = 0
         self.episode: Episode | None = None
         self.state: SimState | None = None
-        self.steps = 0
         r = self.n_robots
         # steps since each robot's start (differ from ``steps`` only after a respawn)
         self.robot_steps = np.zeros(r, dtype=np.int64)
@@ -253,6 +145,11 @@ class EpisodeDriver:
         cfg = self.cfg.model_copy(update={"seed": int(seed)})
         return TaskGenerator.from_config(cfg, [self.robot] * self.n_robots)
 
+    @property
+    def steps(self) -> int:
+        """Env steps since the episode's reset (the runner's ticks)."""
+        return self.runner.ticks
+
     # -- episodes ---------------------------------------------------------------------------
     def reset(self, seed: int | None = None, index: int | None = None) -> Obs:
         """Start the next episode (episode 0 of ``seed`` when a seed is given)."""
@@ -268,8 +165,7 @@ class EpisodeDriver:
         ep = self.generator.episode(idx)
         self.episode = ep
         crowd = build_driver(self.cfg.crowd, self.cfg.pedestrians)
-        self.state = self.backend.reset(ep, crowd, derive_rng(self.seed, "episode", idx, "sim"))
-        self.steps = 0
+        self.state = self.runner.reset(ep, crowd, self.seed)
         self.robot_steps = np.zeros(self.n_robots, dtype=np.int64)
         self._episode_index = idx
         self._respawns = 0
@@ -382,8 +278,7 @@ class EpisodeDriver:
         px, py, prev_heading = self.state.robots.poses.tolist()[0]
         prev_dist = self._hypot(gx - px, gy - py)
         if self.substeps == 1:
-            self.state = self.backend.step(cmd, self.dt)
-            self.steps += 1
+            self.state = self.runner.advance(cmd)
             # Collisions.any on scalars (the index arrays are >= -1): four item reads instead
             # of four ufunc calls
             hits = self.state.collisions
@@ -483,14 +378,12 @@ class EpisodeDriver:
     def _advance(self, cmd: FloatArray) -> NDArray[np.bool_]:
         """Step the backend for one action period; ``(r,)`` bool, any contact during it."""
         if self.substeps == 1:
-            self.state = self.backend.step(cmd, self.dt)
+            self.state = self.runner.advance(cmd)
             collision = self.state.collisions.any  # a fresh array
         else:
-            collision = np.zeros(self.n_robots, dtype=bool)
-            for _ in range(self.substeps):
-                self.state = self.backend.step(cmd, self.dt)
-                collision |= self.state.collisions.any
-        self.steps += 1
+            self._contact.any = np.zeros(self.n_robots, dtype=bool)
+            self.state = self.runner.advance(cmd)
+            collision = self._contact.any
         self.robot_steps += 1
         return collision
 
@@ -594,10 +487,8 @@ class EpisodeDriver:
         return (self.steps >= self.env_cfg.max_steps) or self._at_time_limit()
 
     def _at_time_limit(self) -> bool:
-        """The episode's time limit is reached (every robot is truncated)."""
-        assert self.state is not None
-        assert self.episode is not None
-        return bool(self.state.time >= self.episode.time_limit - 1e-9)
+        """The episode's time limit is reached (every robot is truncated): the runner's rule."""
+        return self.runner.at_time_limit()
 
     # -- respawns (multi-robot training) -------------------------------------------------------
     def respawn(self, i: int, min_goal_distance: float, clearance: float) -> bool:
@@ -638,7 +529,7 @@ class EpisodeDriver:
             )
         except SamplingError:
             return False
-        self.state = self.backend.teleport(i, start)
+        self.state = self.runner.teleport(i, start)
         self.goals = self.goals.copy()
         self.goals[i] = goal.as_array()
         self.last_action = self.last_action.copy()

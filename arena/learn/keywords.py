@@ -80,3 +80,35 @@ def _yaml_value(owner: str, key: str, value: Any) -> str:
         )
 
     return json.dumps(plain(value))  # JSON is YAML flow syntax
+
+
+ConfigLike = ExperimentConfig | str | Path | None
+
+
+def resolve_config(
+    config: ConfigLike,
+    overrides: Sequence[str] = (),
+    keywords: Mapping[str, Any] | None = None,
+    *,
+    owner: str = "SocialNavEnv",
+) -> ExperimentConfig:
+    """An :class:`ExperimentConfig` from a config, a YAML path (+ overrides) or ``None``.
+
+    Args:
+        config: a built config, a YAML path or ``None`` (the packaged default).
+        overrides: ``key.path=value`` strings, applied to the YAML.
+        keywords: top-level config keys given as keyword arguments, applied after
+            ``overrides`` (see :func:`~arena.learn.keywords.load_with_keywords`).
+        owner: the class named in error messages.
+
+    Raises:
+        ConfigError: an invalid config, override or keyword, in one line.
+    """
+    if isinstance(config, ExperimentConfig):
+        if overrides or keywords:
+            raise ConfigError(
+                f"{owner}: overrides and config keywords apply to a YAML path or None, "
+                "not to a built ExperimentConfig (use cfg.model_copy(update=...))"
+            )
+        return config
+    return load_with_keywords(config, overrides, keywords or {}, owner)

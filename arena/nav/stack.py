@@ -506,6 +506,9 @@ class NavigationStack:
         footprint_radius: float | None = None,
         kinematics: str | None = None,
         path: str | None = "navigation",
+        local_planner: LocalPlanner | None = None,
+        scan_range_max: float = math.inf,
+        goal_tolerance: tuple[float, float | None] | None = None,
     ) -> NavigationStack:
         """Build both planners through their registries from a ``navigation`` block.
 
@@ -516,6 +519,9 @@ class NavigationStack:
             footprint_radius: the footprint's inscribed radius (m), for narrow passages.
             kinematics: the robot's kinematics name (checked against the local planner).
             path: key path of the block inside ``source``, for error messages.
+            local_planner: a planner instance used instead of the block's (a trainer's).
+            scan_range_max: m, laser ranges at or past it are free space (the sensor's max).
+            goal_tolerance: ``(xy m, yaw rad or None)`` instead of the block's.
 
         Raises:
             ConfigError: naming ``source`` and the key path when the block is invalid.
@@ -544,7 +550,9 @@ class NavigationStack:
             except ValidationError as e:
                 raise from_validation_error(e, source=source, prefix=path) from None
         gp = GLOBAL_PLANNERS.build(cfg.global_planner, source=source, path=sub("global_planner"))
-        lp = LOCAL_PLANNERS.build(cfg.local_planner, source=source, path=sub("local_planner"))
+        lp = local_planner if local_planner is not None else LOCAL_PLANNERS.build(
+            cfg.local_planner, source=source, path=sub("local_planner")
+        )
         ip = INTERMEDIATE_PLANNERS.build(
             cfg.intermediate_planner, source=source, path=sub("intermediate_planner")
         )
@@ -554,7 +562,7 @@ class NavigationStack:
                 footprint_radius=footprint_radius,
                 planning_resolution=cfg.planning_resolution,
                 replan_period=cfg.replan_period,
-                goal_tolerance=(cfg.goal_tolerance_xy, cfg.goal_tolerance_yaw),
+                goal_tolerance=goal_tolerance or (cfg.goal_tolerance_xy, cfg.goal_tolerance_yaw),
                 max_path_deviation=cfg.max_path_deviation, kinematics=kinematics,
                 intermediate_planner=ip, intermediate_period=cfg.intermediate_period,
                 intermediate_window=cfg.intermediate_window,
@@ -565,7 +573,7 @@ class NavigationStack:
                 oscillation_distance=cfg.oscillation_distance,
                 recovery_behaviors=cfg.recovery_behaviors,
                 back_up_distance=cfg.back_up_distance, back_up_speed=cfg.back_up_speed,
-                rotate_speed=cfg.rotate_speed,
+                rotate_speed=cfg.rotate_speed, scan_range_max=scan_range_max,
             )
         except ConfigError as e:
             raise e.located(source=source, prefix=path) from None

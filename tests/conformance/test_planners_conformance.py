@@ -128,8 +128,8 @@ def random_policy_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     the free-road part of :func:`check_local_planner` checks the plumbing, not luck.
     """
     from arena.learn.config import EnvConfig
+    from arena.learn.planners.learned import LearnedPlanner
     from arena.learn.policy import write_random_policy
-    from arena.nav.local_planners.learned import LearnedPlanner
     from arena.robots.presets import load_robot
 
     env = EnvConfig.model_validate({"observation": {"pedestrians": {"enabled": False}}})

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from arena.core.errors import ConfigError
+from arena.learn.planners.crowdnav import POLICY_DIR, CrowdNavPlanner, SarlPlanner
 from arena.nav.local_planners import LOCAL_PLANNERS
-from arena.nav.local_planners.crowdnav import POLICY_DIR, CrowdNavPlanner, SarlPlanner
 from arena.robots.presets import load_robot
 from tests.nav.planner_kit import line, obs, step, wall_scan
 

@@ -14,9 +14,9 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 from arena.core.errors import ConfigError
 from arena.learn.env import SocialNavEnv
 from arena.learn.observations import goal_polar
+from arena.learn.planners.learned import LearnedPlanner, resample_scan
 from arena.learn.policy import NumpyPolicy, export_policy
 from arena.nav.local_planners.base import LOCAL_PLANNERS, LocalObservation
-from arena.nav.local_planners.learned import LearnedPlanner, resample_scan
 from arena.nav.local_planners.path_tracking import finish_command
 from tests.learn.helpers import small_cfg, small_robot
 

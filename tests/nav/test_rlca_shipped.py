@@ -9,10 +9,10 @@ import numpy as np
 
 from arena.config import load_config
 from arena.experiment import run_experiment
+from arena.learn.planners.learned import PolicyPlanner
+from arena.learn.planners.rlca import RLCA_WEIGHTS, RLCAPlanner
 from arena.learn.policy import NumpyPolicy
 from arena.nav.local_planners import LOCAL_PLANNERS
-from arena.nav.local_planners.learned import PolicyPlanner
-from arena.nav.local_planners.rlca import RLCA_WEIGHTS, RLCAPlanner
 
 
 def test_shipped_weights_are_small_conv_policies():

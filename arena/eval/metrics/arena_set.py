@@ -89,9 +89,11 @@ def menger_curvature(record: EpisodeRecord) -> FloatArray:
 def path_length_value(record: EpisodeRecord) -> float:
     """m, sum of the driven 2-D segment lengths.
 
-    Teleport jumps are left out (see :func:`~arena.eval.metrics.base.driven_segments`).
+    Teleport jumps are left out (see :func:`~arena.eval.metrics.base.driven_segments`): they
+    count 0 m, kept in place so that the sum rounds as over every segment. The one definition
+    of an episode's path length (``EpisodeResult.path_length`` is this of its record).
     """
-    return float(np.sum(segment_lengths(record)[driven_segments(record)]))
+    return float(np.sum(np.where(driven_segments(record), segment_lengths(record), 0.0)))
 
 
 def _driven_pieces(record: EpisodeRecord) -> list[slice]:

@@ -205,7 +205,7 @@ def driven_segments(record: EpisodeRecord) -> BoolArray:
     """``(T−1,)`` False for the segments ``j → j+1`` that a teleport made, True for driven ones.
 
     A teleport of robot 0 is the record event ``(t, "teleport", "robot 0 …")``
-    (:func:`arena.experiment.run_episode` and the recorder write it at the time of the row the
+    (:func:`arena.eval.episodes.run_episode` and the recorder write it at the time of the row the
     robot left, before the next step): the segment from the row at time ``t`` to the next row
     is the jump (it also holds that step's drive, at most ``v_max·Δt``, which is dropped too).
     """

@@ -10,7 +10,7 @@ Interaction in Crowd-Robot Navigation", ROBIO).
 - :mod:`.network`: the CADRL and SARL value networks in numpy and their ``.npz`` file format.
 - :mod:`.train`: imitation from ORCA then RL, in our simulator (torch; the ``train`` extra).
 
-The ``crowdnav`` and ``sarl`` local planners (:mod:`arena.nav.local_planners.crowdnav`) run
+The ``crowdnav`` and ``sarl`` local planners (:mod:`arena.learn.planners.crowdnav`) run
 them. Nothing here imports torch or gymnasium except :mod:`.train`.
 """
 

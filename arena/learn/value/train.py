@@ -64,9 +64,19 @@ from torch import nn
 import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.loader import load_config
 from arena.config.schema import ExperimentConfig
-from arena.core.errors import ArenaError, PlanningError
+from arena.core.errors import ArenaError
 from arena.core.rng import derive_rng
+from arena.core.types import Outcome
 from arena.crowd.driver import build_driver
+from arena.episode.navigation import NavigationController, build_stack
+from arena.episode.runner import EpisodeHooks, EpisodeRunner
+from arena.learn.planners.crowdnav import (
+    CrowdNavPlanner,
+    SarlPlanner,
+    ValuePlanner,
+    ValuePlannerParams,
+    observe,
+)
 from arena.learn.value.network import (
     CADRL_LAYOUT,
     SARL_LAYOUT,
@@ -77,17 +87,7 @@ from arena.learn.value.network import (
     save_value_policy,
 )
 from arena.learn.value.state import PAIR_DIM, SELF_DIM, rotate
-from arena.maps.raster import planning_grid
-from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import KINEMATICS, LOCAL_PLANNERS, LocalObservation, LocalPlanner
-from arena.nav.local_planners.crowdnav import (
-    CrowdNavPlanner,
-    SarlPlanner,
-    ValuePlanner,
-    ValuePlannerParams,
-    observe,
-)
-from arena.nav.stack import NavigationStack, NavStatus
 from arena.robots.presets import load_robot
 from arena.sim.backend import BACKENDS, SimulatorBackend
 from arena.tasks.generator import TaskGenerator
@@ -269,74 +269,73 @@ class RecordingPlanner:
         return np.asarray(self.inner.compute(obs), dtype=np.float64)
 
 
+class _CrowdNavRewards(EpisodeHooks):
+    """CrowdNav's rewards of each tick, added to the logs; the first collision ends the episode.
+
+    ``-0.25`` on a contact; discomfort ``(d - 0.2) · 0.5 · dt`` when the nearest gap ``d`` to a
+    pedestrian is under 0.2 m. A step's reward goes to the last logged tick (none before it).
+    """
+
+    def __init__(self, logs: list[EpisodeLog], robot_radius: float) -> None:
+        self.logs = logs
+        self.robot_radius = float(robot_radius)
+        self._people = 0
+
+    def before_step(self, runner: EpisodeRunner) -> None:
+        assert runner.state is not None
+        self._people = len(runner.state.agents)  # the crowd the command was computed for
+
+    def after_step(self, runner: EpisodeRunner) -> None:
+        state = runner.state
+        assert state is not None
+        if not self.logs[0].rewards:
+            return
+        reward = 0.0
+        if bool(state.collisions.any[0]):
+            reward = -0.25
+            runner.end(Outcome.COLLISION)
+        elif self._people:
+            gap = (np.hypot(*(state.agents.positions - state.robots.poses[0, :2]).T)
+                   - state.agents.radii - self.robot_radius)
+            d = float(np.min(gap))
+            if d < 0.2:
+                reward = (d - 0.2) * 0.5 * runner.dt
+        for lg in self.logs:
+            lg.rewards[-1] += reward
+
+
+# How a training episode's log names each way an episode ends (CrowdNav's four, and "error").
+_LOG_OUTCOME = {
+    Outcome.SUCCESS: "success", Outcome.COLLISION: "collision", Outcome.STUCK: "stuck",
+    Outcome.TIMEOUT: "timeout", Outcome.ABORTED: "timeout",
+    Outcome.PLANNER_FAILURE: "error", Outcome.ERROR: "error",
+}
+
+
 def run_training_episode(cfg: ExperimentConfig, generator: TaskGenerator,
                          backend: SimulatorBackend, index: int,
                          planner: RecordingPlanner) -> list[EpisodeLog]:
     """Simulate episode ``index`` as ``arena run`` would, with ``planner`` as local planner.
 
-    Unlike a benchmark episode it ends at the first collision (CrowdNav's episodes do), and
-    the rewards of each tick are added to the log.
+    The same :class:`~arena.episode.runner.EpisodeRunner`, navigation stack and task runtime
+    as a benchmark episode; unlike one it ends at the first collision (CrowdNav's episodes
+    do), and the rewards of each tick are added to the log. An exception other than an
+    :class:`~arena.core.errors.ArenaError` (a bug) is raised again.
     """
     episode = generator.episode(index)
-    spawn = episode.robots[0]
-    robot = spawn.model
-    crowd = build_driver(cfg.crowd, cfg.pedestrians)
-    state = backend.reset(episode, crowd, derive_rng(cfg.seed, "episode", index, "sim"))
-    stack = NavigationStack.from_config(cfg.navigation, robot_radius=robot.radius)
-    stack.local_planner = planner
-    stack.scan_range_max = float(robot.laser.range_max)
-    stack.goal_tolerance_xy = min(stack.goal_tolerance_xy, 0.9 * episode.goal_radius)
-    if episode.goal_tolerance_angle is not None:
-        stack.goal_tolerance_yaw = float(episode.goal_tolerance_angle)
-    runtime = generator.runtime(episode)
-    limits = robot.limits()
-    angles = robot.laser.angles() + robot.laser.mount[2]
-    origin = np.array(robot.laser.mount[:2])
-    dt = float(cfg.sim.dt)
+    robot = episode.robots[0].model
     planner.logs = logs = [EpisodeLog() for _ in planner.horizons]
-    log = logs[0]
-    try:
-        stack.reset(planning_grid(episode), spawn.start, spawn.goal)
-        while True:
-            update = runtime.update(state.time, state.robots.poses, state.agents.positions)
-            if update.done:
-                log.outcome = "success"
-                break
-            if state.time >= episode.time_limit - 1e-9 or update.reset:
-                break
-            obs = LocalObservation(
-                pose=state.robots.poses[0], twist=state.robots.twists[0], goal=spawn.goal,
-                path=stack.path, limits=limits, robot_radius=robot.radius, dt=dt,
-                scan_ranges=state.robots.scans[0], scan_angles=angles, scan_origin=origin,
-                time=state.time, kinematics=robot.kinematics_type,
-            )
-            a = state.agents
-            peds = Pedestrians(positions=a.positions, velocities=a.velocities,
-                               kinds=a.kinds, states=a.states)
-            cmd = stack.step(obs, peds)
-            if stack.status is NavStatus.STUCK:
-                log.outcome = "stuck"
-                break
-            state = backend.step(np.asarray(cmd, dtype=np.float64)[None, :], dt)
-            if not log.rewards:
-                continue
-            reward = 0.0
-            if bool(state.collisions.any[0]):
-                reward, log.outcome = -0.25, "collision"
-            elif len(a):
-                gap = (np.hypot(*(state.agents.positions - state.robots.poses[0, :2]).T)
-                       - state.agents.radii - robot.radius)
-                d = float(np.min(gap))
-                if d < 0.2:
-                    reward = (d - 0.2) * 0.5 * dt
-            for lg in logs:
-                lg.rewards[-1] += reward
-            if log.outcome == "collision":
-                break
-    except (PlanningError, ArenaError):
-        log.outcome = "error"
+    stack = build_stack(cfg.navigation, robot, episode, local_planner=planner)
+    nav = NavigationController(stack, generator.runtime(episode), robot)
+    runner = EpisodeRunner(backend, cfg.sim.dt, [nav, _CrowdNavRewards(logs, robot.radius)], nav)
+    crowd = build_driver(cfg.crowd, cfg.pedestrians)
+    runner.reset(episode, crowd, cfg.seed)
+    outcome = runner.run()
+    if runner.exception is not None and not isinstance(runner.exception, ArenaError):
+        raise runner.exception
+    assert runner.state is not None
     for lg in logs:
-        lg.outcome, lg.sim_time = log.outcome, float(state.time)
+        lg.outcome, lg.sim_time = _LOG_OUTCOME[outcome], float(runner.state.time)
     return logs
 
 

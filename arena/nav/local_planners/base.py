@@ -154,18 +154,22 @@ class LocalPlanner(Protocol):
         ...
 
 
+_NAV = "arena.nav.local_planners."
+_LEARNED = "arena.learn.planners."  # the planners running learned policies (above nav)
 _BUILTIN_PLANNERS = {
-    "cohan": "cohan", "crowdnav": "crowdnav", "dwa": "dwa", "mpc": "mpc", "orca": "orca_planner",
-    "pure_pursuit": "pure_pursuit", "rlca": "rlca", "rosnav_rl": "learned", "sarl": "crowdnav",
-    "social_force": "social_force", "teb": "teb",
+    "cohan": _NAV + "cohan", "dwa": _NAV + "dwa", "mpc": _NAV + "mpc",
+    "orca": _NAV + "orca_planner", "pure_pursuit": _NAV + "pure_pursuit",
+    "social_force": _NAV + "social_force", "teb": _NAV + "teb",
+    "crowdnav": _LEARNED + "crowdnav", "rlca": _LEARNED + "rlca", "rosnav_rl": _LEARNED + "learned",
+    "sarl": _LEARNED + "crowdnav",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
     "local planner",
     entry_points="arena.local_planners",
-    # name -> the module of arena.nav.local_planners registering it, imported when first named:
-    # a config does not import every planner (``orca`` compiles the ORCA crowd kernels)
-    builtins={name: f"arena.nav.local_planners.{m}" for name, m in _BUILTIN_PLANNERS.items()},
+    # name -> the module registering it, imported when first named: a config does not import
+    # every planner (``orca`` compiles the ORCA crowd kernels)
+    builtins=_BUILTIN_PLANNERS,
 )
 
 

@@ -41,7 +41,7 @@ from arena.nav.local_planners.base import LOCAL_PLANNERS, LocalObservation
 from arena.nav.local_planners.path_tracking import finish_command
 
 DEFAULT_WEIGHTS = (
-    Path(__file__).resolve().parents[2] / "learn" / "data" / "policies" / "rosnav_rl.npz"
+    Path(__file__).resolve().parents[1] / "data" / "policies" / "rosnav_rl.npz"
 )
 """The packaged policy (``arena/learn/data/policies/rosnav_rl.npz``)."""
 SUPPORTED_KEYS = frozenset({"lidar", "goal", "last_action"})

@@ -11,7 +11,7 @@ Description:
 
     Inference is numpy alone (:class:`~arena.learn.policy.NumpyPolicy` runs the Conv1D layers
     and the MLP); the observation is rebuilt from the :class:`LocalObservation` by
-    :class:`~arena.nav.local_planners.learned.PolicyPlanner`: ``lidar`` (the last 3 scans
+    :class:`~arena.learn.planners.learned.PolicyPlanner`: ``lidar`` (the last 3 scans
     resampled onto the policy's beams), ``goal`` and ``velocity`` (the measured body twist
     ``[vx, vy, ω]``).
 
@@ -30,10 +30,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import ClassVar
 
+from arena.learn.planners.learned import PolicyParams, PolicyPlanner
 from arena.nav.local_planners.base import LOCAL_PLANNERS
-from arena.nav.local_planners.learned import PolicyParams, PolicyPlanner
 
-RLCA_WEIGHTS = Path(__file__).resolve().parents[2] / "learn" / "data" / "policies" / "rlca.npz"
+RLCA_WEIGHTS = Path(__file__).resolve().parents[1] / "data" / "policies" / "rlca.npz"
 """The packaged policy (``arena/learn/data/policies/rlca.npz``)."""
 
 

@@ -51,7 +51,7 @@ from arena.nav.local_planners.base import LOCAL_PLANNERS, LocalObservation
 from arena.nav.local_planners.path_tracking import at_goal, finish_command, goal_command
 
 FloatArray = NDArray[np.float64]
-POLICY_DIR = Path(__file__).resolve().parents[2] / "learn" / "data" / "policies"
+POLICY_DIR = Path(__file__).resolve().parents[1] / "data" / "policies"
 """Where the packaged policy files live (``arena/learn/data/policies/``)."""
 WEIGHTS_KEY = "navigation.local_planner.weights"
 
