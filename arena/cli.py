@@ -333,7 +333,7 @@ def maps_export(
     """
     from pydantic import ValidationError
 
-    from arena.sim.mujoco.export import FILE_NAMES, export_scene, load_export_source, write_export
+    from arena.export.world3d import FILE_NAMES, export_scene, load_export_source, write_export
     from arena.sim.mujoco.scene import WorldParams
 
     if fmt not in FILE_NAMES:  # before building anything

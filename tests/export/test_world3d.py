@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from arena.core.errors import ConfigError
+from arena.export.world3d import export_scene, load_export_source
 from arena.maps.io import load_map
 from arena.maps.obstacles import obstacle_model
 from arena.maps.sources import resolve_world
-from arena.sim.mujoco.export import export_scene, load_export_source
 from arena.sim.mujoco.walls import merge_boxes
 from tests.cli_kit import run_cli
 
