@@ -29,10 +29,14 @@ from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import SimulationError
 from arena.maps.grid import OccupancyGrid
-from arena.sensors.lidar2d.bank_kernels import scan_rows, scan_rows_parallel
+from arena.sensors.lidar2d.bank_kernels import (
+    BAD_POSE,
+    BAD_SCENE,
+    scan_rows,
+    scan_rows_parallel,
+)
 from arena.sensors.lidar2d.kernels import SCRATCH_F, SCRATCH_I, _add_noise
 from arena.sensors.lidar2d.model import (
-    _c_array,
     _points,
     beam_tables,
     cell_distances,
@@ -51,6 +55,8 @@ class DynamicGeometry(Protocol):
     World ``w`` owns circles ``circ_off[w]:circ_off[w + 1]`` and segments
     ``seg_off[w]:seg_off[w + 1]``. An owner is the global robot row the shape belongs to (a
     robot's own body is invisible to its sensors) or ``-1`` (nobody, e.g. a pedestrian).
+    Arrays are float64 / int64; C-contiguous writeable ones take the compiled fast path
+    (others compile another specialisation of the kernels on first use).
     """
 
     circ_off: I64  # (W + 1,)
@@ -166,6 +172,9 @@ class LidarBank:
         self._row_robot = np.zeros(0, dtype=np.int64)
         self._row_spec = np.zeros(0, dtype=np.int64)
         self._row_specs: tuple[LidarSpec, ...] = ()
+        self._max_robot = -1
+        self._max_world = -1
+        self._bound = True  # every row's world has been bound (checked at the next scan)
         self._specs: list[LidarSpec] = []  # distinct specs, in order of first use
         self._beam_off = np.zeros(1, dtype=np.int64)
         self._cos = np.zeros(0)
@@ -322,6 +331,9 @@ class LidarBank:
             else:
                 dst[:] = specs[s].range_max
         self._row_world, self._row_robot, self._row_spec = worlds, robots, row_spec
+        self._max_robot = int(robots.max()) if len(robots) else -1
+        self._max_world = int(worlds.max()) if len(worlds) else -1
+        self._bound = False
         self._row_specs = specs
         self._out_off, self._out = out_off, out
         most = int(beams.max()) if len(beams) else 0
@@ -394,33 +406,43 @@ class LidarBank:
         rows = np.flatnonzero(flags)
         if len(rows) == 0:
             return
-        q = _c_array(poses, np.float64)
-        if q.ndim != 2 or q.shape[1] != 3 or q.shape[0] <= int(self._row_robot[rows].max()):
+        q = np.asarray(poses, dtype=np.float64)
+        if q.ndim != 2 or q.shape[1] != 3 or q.shape[0] <= self._max_robot:
             raise SimulationError(
                 f"poses must have shape (R, 3) with a row for every robot, got {q.shape}"
             )
-        if not np.isfinite(q[self._row_robot[rows]]).all():
-            raise SimulationError("LidarBank: the poses of the scanning robots must be finite")
-        worlds = int(self._row_world[rows].max()) + 1
-        for w in np.unique(self._row_world[rows]).tolist():
-            if w >= len(self._world_slot) or self._world_slot[w] is None:
-                raise SimulationError(f"LidarBank.bind_world({w}, ...) was never called")
-        geo = _scene_arrays(scene, worlds)
+        if not self._bound:
+            for w in np.unique(self._row_world).tolist():
+                if w >= len(self._world_slot) or self._world_slot[w] is None:
+                    raise SimulationError(f"LidarBank.bind_world({w}, ...) was never called")
+            self._bound = True  # worlds are never unbound
+        for name in ("circ_off", "seg_off"):
+            off = getattr(scene, name)
+            if off.ndim != 1 or len(off) <= self._max_world + 1:
+                raise SimulationError(f"scene.{name} must have a row per world plus one")
         args = (
             rows, q, self._row_robot, self._row_world, self._row_spec, self._out_off,
             self._beam_off, self._cos, self._sin, self._spec_f,
             self._map_i, self._map_f, self._dist.data[0], self._faces.data[0], self._use_faces,
             self._world_i, self._segs.data[0], self._segs.data[1], _EMPTY_OWNER,
-            *geo, self._scratch_f, self._scratch_i, self._out,
+            scene.circ_off, scene.circ_xy, scene.circ_r, scene.circ_owner,
+            scene.seg_off, scene.seg_a, scene.seg_b, scene.seg_owner,
+            self._scratch_f, self._scratch_i, self._out,
         )
-        if not parallel:
-            scan_rows(*args)
-            return
-        previous = numba.set_parallel_chunksize(chunksize)
-        try:
-            scan_rows_parallel(*args)
-        finally:
-            numba.set_parallel_chunksize(previous)
+        if parallel:
+            previous = numba.set_parallel_chunksize(chunksize)
+            try:
+                code = scan_rows_parallel(*args)
+            finally:
+                numba.set_parallel_chunksize(previous)
+        else:
+            code = scan_rows(*args)
+        if code == BAD_SCENE:
+            raise SimulationError(
+                "scene offsets must rise within the scene's circle and segment arrays"
+            )
+        if code == BAD_POSE:
+            raise SimulationError("LidarBank: the poses of the scanning robots must be finite")
 
     def add_noise(self, s: int, rng: np.random.Generator) -> None:
         """Add row ``s``'s range noise, drawn from ``rng``, to its latest ranges.
@@ -435,22 +457,3 @@ class LidarBank:
             _add_noise(out, rng.standard_normal(out.shape), spec.noise_std, spec.range_min,
                        spec.range_max)
 
-
-def _scene_arrays(scene: DynamicGeometry, worlds: int) -> tuple[NDArray, ...]:
-    """The scene's arrays as the kernels take them, checked against the first ``worlds``."""
-    circ_off = _c_array(scene.circ_off, np.int64)
-    seg_off = _c_array(scene.seg_off, np.int64)
-    cxy = _c_array(scene.circ_xy, np.float64).reshape(-1, 2)
-    cr = _c_array(scene.circ_r, np.float64).reshape(-1)
-    co = _c_array(scene.circ_owner, np.int64).reshape(-1)
-    sa = _c_array(scene.seg_a, np.float64).reshape(-1, 2)
-    sb = _c_array(scene.seg_b, np.float64).reshape(-1, 2)
-    so = _c_array(scene.seg_owner, np.int64).reshape(-1)
-    for name, off, n in (("circ_off", circ_off, len(cxy)), ("seg_off", seg_off, len(sa))):
-        if off.ndim != 1 or len(off) < worlds + 1:
-            raise SimulationError(f"scene.{name} must have a row per world plus one")
-        if off[0] < 0 or off[worlds] > n or np.any(np.diff(off[: worlds + 1]) < 0):
-            raise SimulationError(f"scene.{name} must rise from 0 to at most {n}")
-    if not (len(cr) == len(co) == len(cxy)) or not (len(sb) == len(so) == len(sa)):
-        raise SimulationError("scene circle and segment arrays must agree in length")
-    return circ_off, cxy, cr, co, seg_off, sa, sb, so

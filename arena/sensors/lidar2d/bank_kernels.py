@@ -26,6 +26,8 @@ Tables (built by :class:`~arena.sensors.lidar2d.bank.LidarBank`, all C-contiguou
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 from numba import njit, prange
@@ -38,6 +40,10 @@ F32 = NDArray[np.float32]
 I64 = NDArray[np.int64]
 B1 = NDArray[np.bool_]
 
+#: Codes of :func:`_scan_row` for a row it refused to cast.
+BAD_SCENE = 1
+BAD_POSE = 2
+
 
 @njit(cache=True, fastmath=False)
 def _scan_row(
@@ -48,8 +54,13 @@ def _scan_row(
     circ_off: I64, circ_xy: F64, circ_r: F64, circ_owner: I64,
     seg_off: I64, seg_a: F64, seg_b: F64, seg_owner: I64,
     scratch_f: F64, scratch_i: I64, out: F64,
-) -> None:
-    """Row ``s``'s ranges into its slice of ``out`` (tables: see the module docstring)."""
+) -> int:
+    """Row ``s``'s ranges into its slice of ``out`` (tables: see the module docstring).
+
+    Returns:
+        0, or without casting: :data:`BAD_SCENE` if the scene's slices of the row's world
+        do not fit its arrays, :data:`BAD_POSE` if the robot's pose is not finite.
+    """
     r = row_robot[s]
     w = row_world[s]
     k = row_spec[s]
@@ -66,6 +77,16 @@ def _scan_row(
     c1 = circ_off[w + 1]
     e0 = seg_off[w]
     e1 = seg_off[w + 1]
+    # A bad offset would read outside the arrays (numba does not check bounds): refuse it.
+    if not (
+        0 <= c0 <= c1 <= circ_xy.shape[0] and c1 <= circ_r.shape[0]
+        and c1 <= circ_owner.shape[0] and 0 <= e0 <= e1 <= seg_a.shape[0]
+        and e1 <= seg_b.shape[0] and e1 <= seg_owner.shape[0]
+    ):
+        return BAD_SCENE
+    if not (math.isfinite(poses[r, 0]) and math.isfinite(poses[r, 1])
+            and math.isfinite(poses[r, 2])):
+        return BAD_POSE
     _scan_one(
         poses[r], spec_f[k, 0:3], cos_all[b0:b1], sin_all[b0:b1], spec_f[k, 3], spec_f[k, 4],
         spec_f[k, 5], spec_f[k, 6],
@@ -76,6 +97,7 @@ def _scan_row(
         seg_a[e0:e1], seg_b[e0:e1], seg_owner[e0:e1], r,
         scratch_f, scratch_i, out[out_off[s] : out_off[s + 1]],
     )
+    return 0
 
 
 @njit(cache=True, fastmath=False)
@@ -87,19 +109,23 @@ def scan_rows(
     circ_off: I64, circ_xy: F64, circ_r: F64, circ_owner: I64,
     seg_off: I64, seg_a: F64, seg_b: F64, seg_owner: I64,
     scratch_f: F64, scratch_i: I64, out: F64,
-) -> None:
+) -> int:
     """Cast the sensor rows listed in ``rows`` on the calling thread (scratch ``[0]``).
 
     ``scratch_f`` ``(T, SCRATCH_F, B)`` and ``scratch_i`` ``(T, SCRATCH_I, B)`` are per-thread
-    work arrays, ``B`` the most beams of any row.
+    work arrays, ``B`` the most beams of any row. Returns the largest code of
+    :func:`_scan_row` (0: every row cast).
     """
+    worst = 0
     for j in range(rows.shape[0]):
-        _scan_row(
+        code = _scan_row(
             rows[j], poses, row_robot, row_world, row_spec, out_off, beam_off, cos_all, sin_all,
             spec_f, map_i, map_f, dist, faces, use_faces, world_i, stat_a, stat_b, no_owner,
             circ_off, circ_xy, circ_r, circ_owner, seg_off, seg_a, seg_b, seg_owner,
             scratch_f[0], scratch_i[0], out,
         )
+        worst = max(worst, code)
+    return worst
 
 
 @njit(cache=True, fastmath=False, parallel=True, nogil=True)
@@ -111,17 +137,20 @@ def scan_rows_parallel(
     circ_off: I64, circ_xy: F64, circ_r: F64, circ_owner: I64,
     seg_off: I64, seg_a: F64, seg_b: F64, seg_owner: I64,
     scratch_f: F64, scratch_i: I64, out: F64,
-) -> None:
+) -> int:
     """:func:`scan_rows` on numba's thread pool, each thread on its own scratch.
 
     The caller sets the schedule (``numba.set_parallel_chunksize``): rows differ in cost (a
     scan in a corridor ends sooner than one across a hall), so dynamic chunks balance them.
     """
+    worst = 0
     for j in prange(rows.shape[0]):
         t = numba.get_thread_id()
-        _scan_row(
+        code = _scan_row(
             rows[j], poses, row_robot, row_world, row_spec, out_off, beam_off, cos_all, sin_all,
             spec_f, map_i, map_f, dist, faces, use_faces, world_i, stat_a, stat_b, no_owner,
             circ_off, circ_xy, circ_r, circ_owner, seg_off, seg_a, seg_b, seg_owner,
             scratch_f[t], scratch_i[t], out,
         )
+        worst = max(worst, code)  # a prange reduction
+    return worst

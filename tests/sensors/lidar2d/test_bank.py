@@ -397,6 +397,12 @@ def test_errors_name_the_problem(grids) -> None:
                 np.zeros(0, dtype=np.int64))
     with pytest.raises(SimulationError, match=r"scene\.circ_off must have a row per world"):
         bank.scan(np.ones(1, dtype=bool), np.ones((1, 3)), bad)
+    beyond = Scene(np.array([0, 0, 5]), np.zeros((0, 2)), np.zeros(0),
+                   np.zeros(0, dtype=np.int64), np.zeros(3, dtype=np.int64), np.zeros((0, 2)),
+                   np.zeros((0, 2)), np.zeros(0, dtype=np.int64))
+    for parallel in (False, True):
+        with pytest.raises(SimulationError, match="offsets must rise within the scene's"):
+            bank.scan(np.ones(1, dtype=bool), np.ones((1, 3)), beyond, parallel=parallel)
     with pytest.raises(SimulationError, match="same length"):
         bank.set_sensors([0, 1], [0], [FRONT])
     with pytest.raises(SimulationError, match="scanning robots must be finite"):
