@@ -59,14 +59,37 @@ class DynamicGeometry(Protocol):
     (others compile another specialisation of the kernels on first use).
     """
 
-    circ_off: I64  # (W + 1,)
-    circ_xy: F64  # (C, 2) m
-    circ_r: F64  # (C,) m
-    circ_owner: I64  # (C,)
-    seg_off: I64  # (W + 1,)
-    seg_a: F64  # (K, 2) m
-    seg_b: F64  # (K, 2) m
-    seg_owner: I64  # (K,)
+    @property
+    def circ_off(self) -> I64:
+        """``(W + 1,)`` circle offsets per world."""
+
+    @property
+    def circ_xy(self) -> F64:
+        """``(C, 2)`` circle centres (m)."""
+
+    @property
+    def circ_r(self) -> F64:
+        """``(C,)`` circle radii (m)."""
+
+    @property
+    def circ_owner(self) -> I64:
+        """``(C,)`` owning global robot row, or -1."""
+
+    @property
+    def seg_off(self) -> I64:
+        """``(W + 1,)`` segment offsets per world."""
+
+    @property
+    def seg_a(self) -> F64:
+        """``(K, 2)`` segment start points (m)."""
+
+    @property
+    def seg_b(self) -> F64:
+        """``(K, 2)`` segment end points (m)."""
+
+    @property
+    def seg_owner(self) -> I64:
+        """``(K,)`` owning global robot row, or -1."""
 
 
 class _Blocks:
@@ -304,13 +327,11 @@ class LidarBank:
         for k, spec in enumerate(specs):
             if not isinstance(spec, LidarSpec):
                 raise SimulationError(f"specs[{k}] must be a LidarSpec, got {type(spec).__name__}")
-        index = {}
-        for spec in specs:
-            if spec not in self._specs and spec not in index:
-                index[spec] = len(self._specs) + len(index)
-        if index:
-            self._add_specs(list(index))
-        row_spec = np.array([self._specs.index(s) for s in specs], dtype=np.int64)
+        distinct = list(dict.fromkeys(specs))
+        if distinct != self._specs:
+            self._set_specs(distinct)
+        index = {spec: k for k, spec in enumerate(self._specs)}
+        row_spec = np.array([index[s] for s in specs], dtype=np.int64)
         beams = np.array([s.num_beams for s in specs], dtype=np.int64)
         out_off = np.zeros(len(specs) + 1, dtype=np.int64)
         np.cumsum(beams, out=out_off[1:])
@@ -342,28 +363,28 @@ class LidarBank:
             self._scratch_f = np.zeros((t, SCRATCH_F, most))
             self._scratch_i = np.zeros((t, SCRATCH_I, most), dtype=np.int64)
 
-    def _add_specs(self, new: list[LidarSpec]) -> None:
-        """Append the beam tables of ``new`` specs and their faces-or-walk choice per map."""
-        cos, sin, spec_f = [self._cos], [self._sin], [self._spec_f]
-        for spec in new:
-            c, s, inc = beam_tables(spec)
-            cos.append(c)
-            sin.append(s)
-            spec_f.append(
-                np.array([[*spec.mount, spec.angle_min, inc, spec.range_min, spec.range_max]])
-            )
-        self._specs += new
-        self._cos, self._sin = np.concatenate(cos), np.concatenate(sin)
-        self._spec_f = np.ascontiguousarray(np.concatenate(spec_f))
-        self._beam_off = np.zeros(len(self._specs) + 1, dtype=np.int64)
-        np.cumsum([s.num_beams for s in self._specs], out=self._beam_off[1:])
-        use = np.zeros((len(self._map_i), len(self._specs)), dtype=bool)
-        use[:, : self._use_faces.shape[1]] = self._use_faces
+    def _set_specs(self, specs: list[LidarSpec]) -> None:
+        """Beam tables of the distinct ``specs`` in use and their faces-or-walk choice per map.
+
+        Rebuilt from the specs in use only, so that specs drawn afresh per episode (domain
+        randomisation) do not pile up.
+        """
+        tables = [beam_tables(spec) for spec in specs]
+        self._specs = specs
+        self._cos = np.concatenate([np.zeros(0), *(t[0] for t in tables)])
+        self._sin = np.concatenate([np.zeros(0), *(t[1] for t in tables)])
+        self._spec_f = np.array(
+            [[*spec.mount, spec.angle_min, t[2], spec.range_min, spec.range_max]
+             for spec, t in zip(specs, tables, strict=True)],
+            dtype=np.float64,
+        ).reshape(len(specs), 7)
+        self._beam_off = np.zeros(len(specs) + 1, dtype=np.int64)
+        np.cumsum([s.num_beams for s in specs], out=self._beam_off[1:])
+        self._use_faces = np.zeros((len(self._map_i), len(specs)), dtype=bool)
         for slot in self._slots.values():
             faces = wall_faces(slot.grid)
-            for k in range(self._use_faces.shape[1], len(self._specs)):
-                use[slot.index, k] = use_wall_faces(faces, self._specs[k].num_beams)
-        self._use_faces = use
+            for k, spec in enumerate(specs):
+                self._use_faces[slot.index, k] = use_wall_faces(faces, spec.num_beams)
 
     # -- scanning ------------------------------------------------------------------------------
     @property

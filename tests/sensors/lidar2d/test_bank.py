@@ -324,11 +324,18 @@ def test_rebinding_worlds_with_other_grids(grids) -> None:
             )
             worlds[w] = random_world(rng, grid)
             bank.bind_world(w, grid, worlds[w].obst_a, worlds[w].obst_b)
+        # world 4's robots draw their lidar afresh each episode (sensor randomisation)
+        worlds[4].sensors = [
+            [ROUND.model_copy(update={"num_beams": int(rng.integers(20, 400)),
+                                      "range_max": float(rng.uniform(2.0, 9.0))})]
+            for _ in worlds[4].sensors
+        ]
         poses, scene, row_world, row_robot, specs = pack(worlds)
         bank.set_sensors(row_world, row_robot, specs)
         bank.scan(np.ones(bank.num_rows, dtype=bool), poses, scene)
         want = [r for world in worlds for r in reference(world)]
         assert all(np.array_equal(a, b) for a, b in zip(rows_of(bank), want, strict=True)), k
+        assert len(bank._specs) <= len(set(specs))  # tables of specs no row uses are dropped
     # back to a grid shown before, and the same grid object in another world
     worlds[1] = random_world(rng, grids[0])
     bank.bind_world(1, grids[0], worlds[1].obst_a, worlds[1].obst_b)
