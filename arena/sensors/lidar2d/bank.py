@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 import numba
 import numpy as np
@@ -99,7 +99,7 @@ class _Blocks:
     """
 
     def __init__(self, *columns: tuple[tuple[int, ...], type]) -> None:
-        self.data = [np.zeros((0, *tail), dtype=dtype) for tail, dtype in columns]
+        self.data: list[NDArray[Any]] = [np.zeros((0, *t), dtype=d) for t, d in columns]
         self.off: list[int] = []
         self.size: list[int] = []  # -1: a free id
         self._free: list[int] = []
@@ -109,7 +109,7 @@ class _Blocks:
         """Whether ``n`` more rows fit without :meth:`compact`."""
         return self._end + n <= len(self.data[0])
 
-    def add(self, *arrays: NDArray) -> int:
+    def add(self, *arrays: NDArray[Any]) -> int:
         """Append one block (``arrays`` with equal lengths, one per column set); its id.
 
         The caller makes :meth:`room` first (compacting moves the other blocks, whose offsets
@@ -163,7 +163,6 @@ class _MapSlot:
     index: int  # row of the map tables
     dist: int  # block id in LidarBank._dist
     faces: int  # block id in LidarBank._faces
-    num_faces: int
     worlds: int = 0  # worlds showing it now
 
 
@@ -205,7 +204,8 @@ class LidarBank:
         self._spec_f = np.zeros((0, 7))
         self._out_off = np.zeros(1, dtype=np.int64)
         self._out = np.zeros(0)
-        threads = numba.config.NUMBA_NUM_THREADS  # the most get_thread_id() can return, + 1
+        # the pool's size, fixed at start-up: get_thread_id() < it
+        threads = int(numba.config.NUMBA_NUM_THREADS)  # type: ignore[attr-defined]
         self._scratch_f = np.zeros((threads, SCRATCH_F, 0))
         self._scratch_i = np.zeros((threads, SCRATCH_I, 0), dtype=np.int64)
 
@@ -285,7 +285,7 @@ class LidarBank:
             grown = np.zeros((index + 1, self._use_faces.shape[1]), dtype=bool)
             grown[:index] = self._use_faces
             self._use_faces = grown
-        slot = _MapSlot(grid, index, self._dist.add(dist), self._faces.add(faces), len(faces))
+        slot = _MapSlot(grid, index, self._dist.add(dist), self._faces.add(faces))
         self._map_i[index] = (
             self._dist.off[slot.dist], grid.height, grid.width, self._faces.off[slot.faces],
             len(faces),
