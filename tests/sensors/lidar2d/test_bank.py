@@ -216,6 +216,11 @@ def two_threads():
 @pytest.mark.parametrize("parallel", [False, True])
 def test_rows_equal_lidar2d_scan_many(seed: int, parallel: bool, grids, two_threads) -> None:
     worlds = worlds_for(seed, grids)
+    # the scenes hold two-sensor robots, round and box robots, pedestrians and obstacles
+    assert any(len(s) == 2 for world in worlds for s in world.sensors)
+    radii = [r for world in worlds for r in world.radius]
+    assert None in radii and any(r is not None for r in radii)
+    assert sum(len(w.peds) for w in worlds) > 0 and sum(len(w.obst_a) for w in worlds) > 0
     bank, poses, scene = build(worlds)
     bank.scan(np.ones(bank.num_rows, dtype=bool), poses, scene, parallel=parallel)
     want = [r for world in worlds for r in reference(world)]
