@@ -298,7 +298,7 @@ def _face_hit(
         t_out[i] = t
 
 
-@njit(cache=True, fastmath=False)
+@njit(cache=True, fastmath=False, inline="always")
 def _scan_one(
     pose: NDArray[np.float64], mount: NDArray[np.float64],
     cos_a: NDArray[np.float64], sin_a: NDArray[np.float64], angle_min: float, inc: float,
@@ -317,6 +317,8 @@ def _scan_one(
     angular window), then the grid limited to the nearest hit so far, then clipping. This is
     the only scan code: :func:`_scan_kernel` (one world, one spec) and the rows kernels of
     :mod:`.bank_kernels` (every sensor of every world) both call it per sensor.
+    Inlined into its callers (numba IR): a call with some thirty array arguments costs about
+    1 % of a jackal scan.
 
     Args:
         pose: ``(3,)`` robot pose ``[x m, y m, yaw rad]``.
