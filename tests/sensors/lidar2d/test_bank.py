@@ -359,6 +359,12 @@ def test_set_sensors_keeps_the_held_ranges_of_unchanged_rows(grids) -> None:
     bank.scan(np.ones(bank.num_rows, dtype=bool), poses, scene)
     before = rows_of(bank)
     old_world = bank._row_world.copy()
+    # equal specs rebuilt per episode (new objects): nothing changes, no row is touched
+    _, _, row_world, row_robot, specs = pack(worlds)
+    view = bank.ranges(0)
+    bank.set_sensors(row_world, row_robot, [s.model_copy() for s in specs])
+    assert bank.ranges(0).base is view.base
+    assert all(np.array_equal(a, b) for a, b in zip(rows_of(bank), before, strict=True))
     # world 2 resets with another robot count; the other worlds keep their rows and ranges
     worlds[2].poses = np.vstack([worlds[2].poses, [[5.0, 5.0, 0.0]]])
     worlds[2].radius = [*worlds[2].radius, 0.3]
