@@ -174,7 +174,8 @@ class LidarBank:
 
     Usage: ``bank = LidarBank()``; when world ``w`` resets, ``bank.bind_world(w, grid, a, b)``;
     after any reset ``bank.set_sensors(row_world, row_robot, specs)``; per step
-    ``bank.scan(due, poses, scene)`` and read ``bank.ranges(s)``.
+    ``bank.scan(due, poses, scene)`` and read ``bank.ranges(s)``. One caller at a time: the
+    work arrays are per pool thread, not per caller.
     """
 
     def __init__(self) -> None:
