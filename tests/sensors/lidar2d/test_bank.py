@@ -281,7 +281,7 @@ def test_world_rows_independent_of_w_and_other_worlds(grids) -> None:
     bank, poses, scene = build(worlds)
     bank.scan(np.ones(bank.num_rows, dtype=bool), poses, scene, parallel=True)
     full = rows_of(bank)
-    mine = [s for s in range(bank.num_rows) if bank._row_world[s] == 3]
+    mine = np.flatnonzero(pack(worlds)[2] == 3)
     alone_bank, alone_poses, alone_scene = build([worlds[3]])
     alone_bank.scan(np.ones(alone_bank.num_rows, dtype=bool), alone_poses, alone_scene)
     assert len(mine) == alone_bank.num_rows
@@ -292,7 +292,7 @@ def test_world_rows_independent_of_w_and_other_worlds(grids) -> None:
     moved = [*others, others[1], worlds[3]]
     bank2, poses2, scene2 = build(moved)
     bank2.scan(np.ones(bank2.num_rows, dtype=bool), poses2, scene2, parallel=True)
-    rows6 = [s for s in range(bank2.num_rows) if bank2._row_world[s] == 6]
+    rows6 = np.flatnonzero(pack(moved)[2] == 6)
     for k, s in enumerate(rows6):
         assert np.array_equal(bank2.ranges(s), alone_bank.ranges(k))
 
@@ -358,7 +358,7 @@ def test_set_sensors_keeps_the_held_ranges_of_unchanged_rows(grids) -> None:
     bank, poses, scene = build(worlds)
     bank.scan(np.ones(bank.num_rows, dtype=bool), poses, scene)
     before = rows_of(bank)
-    old_world = bank._row_world.copy()
+    old_world = pack(worlds)[2]
     # equal specs rebuilt per episode (new objects): nothing changes, no row is touched
     _, _, row_world, row_robot, specs = pack(worlds)
     view = bank.ranges(0)
