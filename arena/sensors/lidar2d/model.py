@@ -158,6 +158,30 @@ def use_wall_faces(faces: NDArray[np.float64], num_beams: int) -> bool:
     return len(faces) <= FACES_PER_BEAM * max(num_beams, 64)
 
 
+def cell_distances(grid: OccupancyGrid) -> NDArray[np.float32]:
+    """``grid``'s distance map in cells, as the scan kernels read it: ``(H, W)`` float32.
+
+    float32 halves the cache traffic; the values are capped so that an empty map's ``inf``
+    becomes one jump out of the map instead of an ``inf`` beam parameter. A new writeable array.
+    """
+    cap = float(grid.width + grid.height + 4)
+    d = np.minimum(np.asarray(grid.distance) / grid.resolution, cap)
+    return np.ascontiguousarray(d, dtype=np.float32)
+
+
+def beam_tables(spec: LidarSpec) -> tuple[FloatArray, FloatArray, float]:
+    """Beam directions of ``spec`` in the sensor frame, as the scan kernels read them.
+
+    Returns:
+        ``(cos, sin, increment)``: ``(num_beams,)`` cosines and sines of the beam angles and the
+        angle between beams (rad); one beam (or a zero span) has no meaningful increment and
+        gets 0, which makes the kernels test every beam against every object.
+    """
+    angles = spec.angles()
+    inc = float(spec.angle_increment) if spec.num_beams > 1 else 0.0
+    return np.cos(angles), np.sin(angles), inc
+
+
 class Lidar2D:
     """A planar laser scanner of one :class:`LidarSpec`, cast against one static world at a time.
 
@@ -177,10 +201,7 @@ class Lidar2D:
         angles = spec.angles()
         angles.setflags(write=False)
         self._angles = angles
-        self._cos = np.cos(angles)
-        self._sin = np.sin(angles)
-        # One beam (or a zero span) has no meaningful increment: the kernel then tests every beam.
-        self._inc = float(spec.angle_increment) if spec.num_beams > 1 else 0.0
+        self._cos, self._sin, self._inc = beam_tables(spec)
         self._mount = np.asarray(spec.mount, dtype=np.float64)
         self._grid: OccupancyGrid | None = None
         self._distg = np.zeros((1, 1), dtype=np.float32)
@@ -218,11 +239,7 @@ class Lidar2D:
         if a.shape != b.shape:
             raise ValueError(f"segments_a {a.shape} and segments_b {b.shape} differ in shape")
         if self._grid is not grid:
-            # Distances in cells, float32 to halve cache traffic; capped so that an empty map's
-            # ``inf`` becomes one jump out of the map instead of an ``inf`` beam parameter.
-            cap = float(grid.width + grid.height + 4)
-            d = np.minimum(np.asarray(grid.distance) / grid.resolution, cap)
-            self._distg = np.ascontiguousarray(d, dtype=np.float32)
+            self._distg = cell_distances(grid)
             # a writeable copy: numba compiles another specialisation for read-only arrays
             self._faces = wall_faces(grid).copy()
             self._use_faces = use_wall_faces(self._faces, self.spec.num_beams)
