@@ -214,8 +214,8 @@ class ContactBank:
             previous: ``(R, 3)`` the poses before the move, or ``None``: walls are also tested
                 along the way from them (tunnelling sweep); obstacles, pedestrians and robots
                 only at ``poses``.
-            ag_off: ``(W + 1,)`` int64, world ``w``'s pedestrians are rows
-                ``ag_off[w]:ag_off[w+1]`` of ``ag_pos`` and ``ag_r``.
+            ag_off: ``(W + 1,)`` int64 (``W`` at least the worlds bound), world ``w``'s
+                pedestrians are rows ``ag_off[w]:ag_off[w+1]`` of ``ag_pos`` and ``ag_r``.
             ag_pos: ``(A, 2)`` m, the pedestrians' positions.
             ag_r: ``(A,)`` m, their radii.
             rows: ``(R,)`` bool, the rows to test (the others get ``False``/``-1``); ``None``:
@@ -233,9 +233,10 @@ class ContactBank:
         if prev.shape != (n, 3):
             raise SimulationError(f"previous poses must have shape ({n}, 3), got {prev.shape}")
         off = np.ascontiguousarray(ag_off, dtype=np.int64)
-        if off.shape != (self.num_worlds + 1,):
+        if off.ndim != 1 or off.shape[0] < self.num_worlds + 1:  # unbound worlds may follow
             raise SimulationError(
-                f"ag_off must have shape ({self.num_worlds + 1},), got {off.shape}"
+                f"ag_off must have shape (W + 1,) for W >= {self.num_worlds} worlds, "
+                f"got {off.shape}"
             )
         pos = np.ascontiguousarray(ag_pos, dtype=np.float64).reshape(-1, 2)
         rad = np.ascontiguousarray(ag_r, dtype=np.float64).reshape(-1)

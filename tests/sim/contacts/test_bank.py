@@ -224,5 +224,5 @@ def test_misuse_is_a_one_line_simulation_error():
     no_agents = (np.array([0, 0]), np.zeros((0, 2)), np.zeros(0))
     with pytest.raises(SimulationError, match=r"poses must have shape \(2, 3\)"):
         bank.test(np.zeros((3, 3)), None, *no_agents)
-    with pytest.raises(SimulationError, match=r"ag_off must have shape \(2,\)"):
+    with pytest.raises(SimulationError, match=r"ag_off must have shape \(W \+ 1,\) for W >= 1"):
         bank.test(np.zeros((2, 3)), None, np.array([0]), np.zeros((0, 2)), np.zeros(0))
