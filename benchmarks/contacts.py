@@ -1,6 +1,6 @@
 """Contact tests: µs per robot for one world, robot rows/s for 64 worlds, serial and threaded.
 
-    python benchmarks/contacts.py [--reps 20000] [--threads 2]
+    python benchmarks/contacts.py [--reps 20000] [--threads 2] [--worlds 64]
 
 The world: a 30 x 30 m map at 0.05 m/cell with border and interior walls, 20 placed box
 obstacles and 30 pedestrians (r = 0.3 m), a jackal footprint (rectangle) moving 0.04 m per step
@@ -8,11 +8,18 @@ obstacles and 30 pedestrians (r = 0.3 m), a jackal footprint (rectangle) moving 
 
 - W = 1, one robot: ``ContactBank.test`` (all four tests, sweep on) and the one-robot wrappers
   (``hits_grid`` + ``first_obstacle_hit`` + ``first_agent_hit``), µs per robot;
-- W = 64 worlds x 1 robot (one shared grid, per-world obstacles and pedestrians): robot rows/s
-  through ``ContactBank.test``, serial and over ``--threads`` numba threads.
+- W = 64 worlds x 1 robot (``--worlds``; one shared grid, per-world obstacles and pedestrians):
+  robot rows/s through ``ContactBank.test``, serial and over ``--threads`` numba threads.
+
+Threads wait passively (``OMP_WAIT_POLICY=PASSIVE``, as the engine's benchmarks): spinning
+threads on a busy 2-core host make the threaded call 50 times slower.
 """
 
 from __future__ import annotations
+
+import os
+
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import argparse
 import time
@@ -74,6 +81,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--reps", type=int, default=20000, help="one-robot calls timed")
     ap.add_argument("--threads", type=int, default=2, help="numba threads, parallel run")
+    ap.add_argument("--worlds", type=int, nargs="+", default=[64], help="W, one robot each")
     args = ap.parse_args()
     rng = np.random.default_rng(0)
     jackal = load_robot("jackal")
@@ -110,42 +118,40 @@ def main() -> None:
         first_agent_hit(fp, p, agents, radii)
     wrappers_us = 1e6 * (time.perf_counter() - t0) / args.reps
 
-    # -- W = 64 x 1 robot ----------------------------------------------------------------------
-    n_worlds = 64
-    bank64 = ContactBank()
-    ped = []
-    for w in range(n_worlds):
-        wd, a = world(g, rng)
-        bank64.bind_world(w, wd)
-        ped.append(a)
-    bank64.set_robots(np.arange(n_worlds, dtype=np.int64), [fp] * n_worlds)
-    ag_pos = np.concatenate(ped)
-    ag_r = np.full(len(ag_pos), 0.3)
-    ag_off = np.arange(0, len(ag_pos) + 1, 30, dtype=np.int64)
-    steps = max(args.reps // n_worlds, 50)
-    batches = [moves(rng, n_worlds) for _ in range(steps)]
-    rates = {}
+    # -- W worlds x 1 robot ---------------------------------------------------------------------
     threads = numba.get_num_threads()
-    for label, parallel, nthreads in (
-        ("serial", False, 1),
-        (f"{min(args.threads, threads)} threads", True, min(args.threads, threads)),
-    ):
-        numba.set_num_threads(nthreads)
-        for p, q in batches[:20]:  # warm-up
-            bank64.test(p, q, ag_off, ag_pos, ag_r, parallel=parallel)
-        t0 = time.perf_counter()
-        for p, q in batches:
-            bank64.test(p, q, ag_off, ag_pos, ag_r, parallel=parallel)
-        rates[label] = steps * n_worlds / (time.perf_counter() - t0)
-    numba.set_num_threads(threads)
+    rates: dict[tuple[int, str], float] = {}
+    for n_worlds in args.worlds:
+        many = ContactBank()
+        ped = []
+        for w in range(n_worlds):
+            wd, a = world(g, rng)
+            many.bind_world(w, wd)
+            ped.append(a)
+        many.set_robots(np.arange(n_worlds, dtype=np.int64), [fp] * n_worlds)
+        ag_pos = np.concatenate(ped)
+        ag_r = np.full(len(ag_pos), 0.3)
+        ag_off = np.arange(0, len(ag_pos) + 1, 30, dtype=np.int64)
+        steps = max(args.reps // n_worlds, 50)
+        batches = [moves(rng, n_worlds) for _ in range(steps)]
+        nthreads = min(args.threads, threads)
+        for label, parallel, k in (("serial", False, 1), (f"{nthreads} threads", True, nthreads)):
+            numba.set_num_threads(k)
+            for p, q in batches[:20]:  # warm-up
+                many.test(p, q, ag_off, ag_pos, ag_r, parallel=parallel)
+            t0 = time.perf_counter()
+            for p, q in batches:
+                many.test(p, q, ag_off, ag_pos, ag_r, parallel=parallel)
+            rates[n_worlds, label] = steps * n_worlds / (time.perf_counter() - t0)
+        numba.set_num_threads(threads)
 
     print("contact tests benchmark")
     print("  world: 30x30 m @ 0.05 m, 20 obstacles, 30 pedestrians, jackal footprint, sweep on")
     share = 100 * contacts / args.reps
     print(f"  W = 1, ContactBank.test:     {bank_us:8.2f} us/robot   ({share:.1f} % in contact)")
     print(f"  W = 1, one-robot wrappers:   {wrappers_us:8.2f} us/robot   (grid+obstacle+agent)")
-    for label, rate in rates.items():
-        print(f"  W = {n_worlds} x 1 robot, {label:10s} {rate:12,.0f} rows/s")
+    for (n_worlds, label), rate in rates.items():
+        print(f"  W = {n_worlds:4d} x 1 robot, {label:10s} {rate:12,.0f} rows/s")
 
 
 if __name__ == "__main__":
