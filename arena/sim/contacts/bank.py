@@ -89,8 +89,12 @@ class ContactBank:
         self._grid_of[w] = grid
         self._obstacles_of[w] = self._obstacle_index(world)
         self._obstacles_packed = None
-        self._maybe_compact()
-        self._world_grid_arrays()
+        if self._maybe_compact() or self._g_off.shape[0] != len(self._grid_of):
+            self._world_grid_arrays()
+        else:  # only world w changed
+            self._g_off[w] = slot.start
+            self._g_shape[w] = grid.height, grid.width
+            self._g_par[w] = slot.params
 
     def _pack_grid(self, grid: OccupancyGrid) -> _GridSlot:
         """Append ``grid``'s blocking cells and distance map to the flat arrays."""
@@ -108,17 +112,21 @@ class ContactBank:
         self._slots[id(grid)] = slot
         return slot
 
-    def _maybe_compact(self) -> None:
-        """Repack only the grids some world uses once the unused cells outnumber them."""
+    def _maybe_compact(self) -> bool:
+        """Repack only the grids some world uses once the unused cells outnumber them.
+
+        Returns whether it did (the grids moved).
+        """
         live = {id(g) for g in self._grid_of if g is not None}
         live_cells = sum(s.grid.height * s.grid.width for k, s in self._slots.items() if k in live)
         if self._used - live_cells <= max(live_cells, _MIN_COMPACT_CELLS):
-            return
+            return False
         slots = [s for k, s in self._slots.items() if k in live]
         self._slots, self._used = {}, 0
         self._occ, self._dist = np.zeros(live_cells, dtype=np.bool_), np.zeros(live_cells)
         for s in slots:
             self._pack_grid(s.grid)
+        return True
 
     def _world_grid_arrays(self) -> None:
         """Per world: its grid's start in the flat arrays, ``(h, w)`` and parameters."""
@@ -151,9 +159,11 @@ class ContactBank:
             idx = [i for i in self._obstacles_of if i is not None]
             o_off = np.zeros(len(self._obstacles_of) + 1, dtype=np.int64)
             o_off[1:] = np.cumsum([0 if i is None else len(i.polygons) for i in self._obstacles_of])
-            counts = [len(p) for i in idx for p in i.polygons]
-            vstart = np.zeros(len(counts) + 1, dtype=np.int64)
-            vstart[1:] = np.cumsum(counts)
+            base = np.cumsum([0] + [i.verts.shape[0] for i in idx])  # first vertex per world
+            vstart = np.concatenate(
+                [i.vstart[:-1] + b for i, b in zip(idx, base[:-1], strict=True)]
+                + [base[-1:]]
+            ).astype(np.int64)
             self._obstacles_packed = (
                 o_off,
                 np.concatenate([np.zeros((0, 2))] + [i.centers for i in idx]),
