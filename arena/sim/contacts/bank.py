@@ -258,15 +258,16 @@ class ContactBank:
         do = self._all_rows if rows is None else np.ascontiguousarray(rows, dtype=np.bool_)
         if do.shape != (n,):
             raise SimulationError(f"rows must have shape ({n},), got {do.shape}")
-        wall = np.zeros(n, dtype=np.bool_)
-        obstacle = np.full(n, -1, dtype=np.int64)
-        agent = np.full(n, -1, dtype=np.int64)
-        robot = np.full(n, -1, dtype=np.int64)
-        if n:
-            contacts_rows(
-                do, p, prev, previous is not None, self._row_world, self._robot_off,
-                self._g_off, self._g_shape, self._g_par, self._occ, self._dist,
-                *self._packed_obstacles(), *self._fp, off, pos, rad,
-                wall, obstacle, agent, robot, parallel=parallel,
-            )  # fmt: skip
+        wall = np.empty(n, dtype=np.bool_)  # the kernel writes every row
+        obstacle = np.empty(n, dtype=np.int64)
+        agent = np.empty(n, dtype=np.int64)
+        robot = np.empty(n, dtype=np.int64)
+        o_off, o_c, o_r, o_vs, o_v = self._packed_obstacles()
+        fp_r, fp_reach, fp_vs, fp_v = self._fp
+        contacts_rows(parallel)(
+            do, p, prev, previous is not None, self._row_world, self._robot_off,
+            self._g_off, self._g_shape, self._g_par, self._occ, self._dist,
+            o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, off, pos, rad,
+            wall, obstacle, agent, robot,
+        )  # fmt: skip
         return wall, obstacle, agent, robot

@@ -19,6 +19,7 @@ call the same functions one robot at a time.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 from numba import njit, prange
@@ -390,6 +391,7 @@ def robots_overlap(
 @njit(cache=True)
 def _contacts_row(
     i: int,
+    rows_i: bool,
     poses: NDArray[np.float64],
     previous: NDArray[np.float64],
     sweep: bool,
@@ -417,7 +419,16 @@ def _contacts_row(
     agent: NDArray[np.int64],
     robot: NDArray[np.int64],
 ) -> None:
-    """All four tests of global robot row ``i``, on its own world's slices only."""
+    """All four tests of global robot row ``i``, on its own world's slices only.
+
+    With ``rows_i`` false it only writes "no contact" (``False``, ``-1``) into row ``i``.
+    """
+    robot[i] = -1
+    if not rows_i:
+        wall[i] = False
+        obstacle[i] = -1
+        agent[i] = -1
+        return
     w = row_world[i]
     h, wd = g_shape[w, 0], g_shape[w, 1]
     start = g_off[w]
@@ -449,14 +460,13 @@ def _rows_serial(
     occ, dist, o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, ag_off, ag_pos, ag_r,
     wall, obstacle, agent, robot,
 ) -> None:  # fmt: skip
-    """:func:`_contacts_row` for each row with ``rows[i]``, one after the other."""
+    """:func:`_contacts_row` for each row (tested where ``rows[i]``), one after the other."""
     for i in range(rows.shape[0]):
-        if rows[i]:
-            _contacts_row(
-                i, poses, previous, sweep, row_world, robot_off, g_off, g_shape, g_par, occ,
-                dist, o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, ag_off, ag_pos,
-                ag_r, wall, obstacle, agent, robot,
-            )  # fmt: skip
+        _contacts_row(
+            i, rows[i], poses, previous, sweep, row_world, robot_off, g_off, g_shape, g_par,
+            occ, dist, o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, ag_off, ag_pos,
+            ag_r, wall, obstacle, agent, robot,
+        )  # fmt: skip
 
 
 @njit(cache=True, parallel=True)
@@ -467,18 +477,17 @@ def _rows_parallel(
 ) -> None:  # fmt: skip
     """:func:`_rows_serial` over numba's threads (each row writes only its own outputs)."""
     for i in prange(rows.shape[0]):
-        if rows[i]:
-            _contacts_row(
-                i, poses, previous, sweep, row_world, robot_off, g_off, g_shape, g_par, occ,
-                dist, o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, ag_off, ag_pos,
-                ag_r, wall, obstacle, agent, robot,
-            )  # fmt: skip
+        _contacts_row(
+            i, rows[i], poses, previous, sweep, row_world, robot_off, g_off, g_shape, g_par,
+            occ, dist, o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, ag_off, ag_pos,
+            ag_r, wall, obstacle, agent, robot,
+        )  # fmt: skip
 
 
-def contacts_rows(*args: object, parallel: bool = False) -> None:
-    """Run the contact tests of the selected rows, serially or over threads (same results).
+def contacts_rows(parallel: bool) -> Callable[..., None]:
+    """The rows kernel: :func:`_rows_parallel` (numba's threads) or :func:`_rows_serial`.
 
-    ``args`` are :func:`_rows_serial`'s, in its order (built by
-    :class:`~arena.sim.contacts.bank.ContactBank`); the four outputs are written in place.
+    Both give the same flags. Their arguments are built by
+    :class:`~arena.sim.contacts.bank.ContactBank`; every row of the four outputs is written.
     """
-    (_rows_parallel if parallel else _rows_serial)(*args)
+    return _rows_parallel if parallel else _rows_serial
