@@ -4,12 +4,14 @@ A robot's footprint ``body`` is its ``(k, 2)`` convex polygon in the robot frame
 ``(0, 2)`` array for a circle of ``radius`` (m). Each test first rejects with a bounding circle,
 so the common "nothing near" case costs a few array look-ups.
 
-The float operations are those of the NumPy functions this module replaced
+The float operations are those of the NumPy code this module replaced
 (:func:`~arena.core.geometry.transform_points`, ``point_segment_distance``,
-``segments_intersect``, ``convex_polygon_overlaps_squares`` ...), element by element, so every
-flag came out the same. The one exception is written down where it is: the separating-axis
-projections are fused multiply-adds as OpenBLAS rounded the former matrix products, now the same
-on every CPU.
+``segments_intersect``, ``convex_polygon_overlaps_squares`` ...), element by element: on 100,000
+random poses and 20,000 poses bisected onto the touching boundary every flag came out the same,
+but for one robot-robot boundary case in 5,000 (the bounding-circle reject and the sweep length
+use the C library's ``hypot``, Python's ``math.hypot`` may round 1 ulp apart). The
+separating-axis projections are fused multiply-adds, as OpenBLAS's FMA kernels rounded the former
+matrix products (plain products changed 547 of those boundary flags): now the same on every CPU.
 
 :func:`contacts_rows` tests every robot of every world in one call (flat layout of
 :mod:`arena.sim.contacts.bank`); the per-robot wrappers of :mod:`arena.sim.contacts.checks`
