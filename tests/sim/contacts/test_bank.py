@@ -185,6 +185,7 @@ def test_rows_mask_leaves_the_others_untouched():
     mask = np.array([True, False, True, False, True, True])
     part = bank.test(*scene, rows=mask)
     assert_flags_equal(part, all_rows, rows=mask)
+    assert_flags_equal(bank.test(*scene, rows=mask, parallel=True), part)
     assert not part[0][~mask].any()
     for flags in part[1:]:
         assert (flags[~mask] == -1).all()
