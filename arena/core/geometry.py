@@ -109,29 +109,37 @@ def points_in_polygon(points: ArrayLike, polygon: ArrayLike) -> NDArray[np.bool_
 
 @njit(cache=True)
 def _points_in_polygon(p: FloatArray, poly: FloatArray) -> NDArray[np.bool_]:
-    """Count the edges ``a→b`` that a ray from each point towards +x crosses.
+    """:func:`point_in_polygon` for each point ``(n, 2)`` → ``(n,)`` bool.
 
-    An edge counts when it straddles the point's ``y`` and its ``x`` there,
-    ``a_x + (y - a_y)(b_x - a_x) / (b_y - a_y)``, lies right of the point: the float
-    operations of the vectorised version this replaced (so the same answers), without its
-    ``(n, k)`` temporaries (rasterising one footprint made a dozen of them).
+    The compiled loop replaced a vectorised version with the same float operations (so the same
+    answers), without its ``(n, k)`` temporaries (rasterising one footprint made a dozen).
     """
     n = p.shape[0]
-    k = poly.shape[0]
     inside = np.zeros(n, dtype=np.bool_)
     for i in range(n):
-        px = p[i, 0]
-        py = p[i, 1]
-        count = 0
-        for e in range(k):
-            ax = poly[e, 0]
-            ay = poly[e, 1]
-            bx = poly[(e + 1) % k, 0]
-            by = poly[(e + 1) % k, 1]
-            if (ay > py) != (by > py) and px < ax + (py - ay) * (bx - ax) / (by - ay):
-                count += 1
-        inside[i] = count % 2 == 1
+        inside[i] = point_in_polygon(p[i, 0], p[i, 1], poly)
     return inside
+
+
+@njit(cache=True)
+def point_in_polygon(px: float, py: float, poly: FloatArray) -> bool:
+    """Even-odd test of the point ``(px, py)`` (m) against the polygon ``(k, 2)`` (m), compiled.
+
+    Counts the edges ``a→b`` that a ray from the point towards +x crosses: an edge counts when
+    it straddles ``py`` and its ``x`` there, ``a_x + (py - a_y)(b_x - a_x) / (b_y - a_y)``, lies
+    right of the point. The one implementation: :func:`points_in_polygon` and the contact
+    kernels (:mod:`arena.sim.contacts.kernels`) call it.
+    """
+    k = poly.shape[0]
+    count = 0
+    for e in range(k):
+        ax = poly[e, 0]
+        ay = poly[e, 1]
+        bx = poly[(e + 1) % k, 0]
+        by = poly[(e + 1) % k, 1]
+        if (ay > py) != (by > py) and px < ax + (py - ay) * (bx - ax) / (by - ay):
+            count += 1
+    return count % 2 == 1
 
 
 def point_segment_distance(points: ArrayLike, a: ArrayLike, b: ArrayLike) -> FloatArray:

@@ -19,7 +19,7 @@ from arena.core.errors import ConfigError
 from arena.maps.grid import OccupancyGrid
 from arena.scene.episode import RobotSpawn
 from arena.scene.state import Obstacle, StaticWorld
-from arena.sim.native2d.collisions import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
+from arena.sim.contacts import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
 
 if TYPE_CHECKING:  # read, never built here: scenario.py imports these checks
     from arena.tasks.scenario import Scenario

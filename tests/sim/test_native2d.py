@@ -10,8 +10,8 @@ from arena.crowd.simulator import CrowdSimulator, PedestrianConfig
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
 from arena.scene.state import Obstacle
+from arena.sim.contacts import Footprint, hits_grid
 from arena.sim.native2d import Native2DBackend
-from arena.sim.native2d.collisions import Footprint, hits_grid
 from tests.conftest import make_episode, standing_agents
 
 DT = 0.1

@@ -12,7 +12,7 @@ from arena.nav.global_planners.astar import AStarPlanner
 from arena.robots.presets import load_robot
 from arena.scene.episode import episode_digest
 from arena.scene.state import StaticWorld
-from arena.sim.native2d.collisions import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
+from arena.sim.contacts import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
 from arena.tasks.config import TaskConfig
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.obstacle_modes.random import RandomObstacles

@@ -5,7 +5,7 @@ import pytest
 
 from arena.robots.presets import load_robot
 from arena.scene.state import StaticWorld
-from arena.sim.native2d.collisions import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
+from arena.sim.contacts import Footprint, ObstacleIndex, first_obstacle_hit, hits_grid
 from arena.tasks.config import TaskConfig
 from arena.tasks.generator import TaskGenerator
 from arena.tasks.robot_modes.random import spawn_radius

@@ -2,7 +2,7 @@ import numpy as np
 
 from arena.core.geometry import circles_overlap_polygon, rectangle, transform_points
 from arena.maps.grid import OccupancyGrid
-from arena.sim.native2d.collisions import Footprint, first_agent_hit, hits_grid
+from arena.sim.contacts import Footprint, first_agent_hit, hits_grid
 
 
 def reference_agent_hit(fp, pose, pos, radii):
@@ -46,7 +46,7 @@ def test_hits_grid_circle_matches_dense_sampling():
 
 def test_near_circles_matches_the_numpy_rejection_test():
     """The compiled bounding-circle test selects exactly what ``hypot(...) <= r`` selects."""
-    from arena.sim.native2d.collisions import _near_circles
+    from arena.sim.contacts.kernels import _near_circles
 
     rng = np.random.default_rng(1)
     for _ in range(300):
