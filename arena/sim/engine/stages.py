@@ -1,0 +1,225 @@
+"""The stages of one engine step, in their fixed order: crowd, kinematics, contacts, sensors.
+
+A stage is an object with ``reset_worlds(engine, worlds)`` (after worlds were (re)loaded: the
+robot and sensor rows may have changed) and ``step(engine, commands, dt)``; the engine holds
+them in a tuple and calls them in order. A later engine (GPU, 3-D) swaps stages, not the loop.
+Each stage reads and replaces the engine's flat arrays (never writes into arrays it handed
+out, so a caller may keep them).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Protocol
+
+import numba
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from arena.core.errors import SimulationError
+from arena.robots.kinematics.base import (
+    Kinematics,
+    KinematicState,
+    _box_twist_row,
+    _integrate_row,
+)
+from arena.sensors.lidar2d.kernels import _add_noise
+from arena.sim.engine.scene import SceneBuilder, pedestrian_circles
+
+if TYPE_CHECKING:
+    from arena.sim.engine.engine import Engine
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+
+class Stage(Protocol):
+    """One stage of :meth:`Engine.step`."""
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Worlds ``worlds`` were loaded; rows may have moved."""
+        ...
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Advance this stage's part of every world by ``dt`` s."""
+        ...
+
+
+class CrowdStage:
+    """Each world's pedestrian driver, in world order, sees its robots as at the step start."""
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Nothing to do: drivers are reset by :meth:`Engine.reset_worlds`."""
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Step every driver; track the distance walked where the legs gait needs it."""
+        moved = False
+        track = engine.tracks_walked
+        for w, driver in enumerate(engine.drivers):
+            if driver is None:
+                continue
+            before = engine.agents[w].positions
+            agents = driver.step(engine.robots_at_start(w), dt)
+            engine.agents[w] = agents
+            moved = True
+            if track and agents.positions.shape == before.shape:
+                walked = engine.walked[w]
+                if walked.shape[0] != len(agents):  # the crowd changed size: a new gait
+                    walked = np.zeros(len(agents))
+                engine.walked[w] = walked + np.hypot(*(agents.positions - before).T)
+        if moved:
+            engine.gather_agents()
+
+
+class KinematicsStage:
+    """Robots grouped by kinematics model and parameters, one call per group.
+
+    Box models (velocity box and per-axis acceleration limits: diff drive, omni) step their
+    rows in one compiled call built on :func:`~arena.robots.kinematics.base.box_step_row`'s row
+    functions (no steering); the others through :meth:`Kinematics.step` on their gathered rows.
+    """
+
+    def __init__(self) -> None:
+        self._groups: list[tuple[Kinematics, I64, tuple[F64, F64, F64] | None]] = []
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Regroup the rows by model (a task generator hands every episode the same model)."""
+        groups: dict[tuple[str, str], tuple[Kinematics, list[int]]] = {}
+        for row, kin in enumerate(engine.kinematics):
+            key = (kin.name, repr(kin.params))  # type: ignore[attr-defined]
+            groups.setdefault(key, (kin, []))[1].append(row)
+        self._groups = [
+            (kin, np.array(rows, dtype=np.int64), getattr(kin, "box_limits", None))
+            for kin, rows in groups.values()
+        ]
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Write the unconstrained next poses, twists and steering into the engine."""
+        poses, twists, steer = engine.poses, engine.twists, engine.steering
+        new_p = np.empty_like(poses)
+        new_t = np.empty_like(twists)
+        new_s = np.empty_like(steer)
+        for kin, rows, box in self._groups:
+            if box is not None:
+                _box_rows(poses, twists, commands, box[0], box[1], box[2], dt, rows, new_p,
+                          new_t)
+                new_s[rows] = 0.0  # box models have no steering
+                continue
+            s = kin.step(KinematicState(poses[rows], twists[rows], steer[rows]), commands[rows], dt)
+            new_p[rows], new_t[rows], new_s[rows] = s.poses, s.twists, s.steering
+        engine.next_poses, engine.next_twists, engine.next_steering = new_p, new_t, new_s
+
+
+@njit(cache=True)
+def _box_rows(
+    poses: F64, twists: F64, cmd: F64, lower: F64, upper: F64, acc: F64, dt: float,
+    rows: I64, out_p: F64, out_t: F64,
+) -> None:
+    """:func:`~arena.robots.kinematics.base.box_step_row` for each row of ``rows``."""
+    for k in range(rows.shape[0]):
+        i = rows[k]
+        _box_twist_row(twists, cmd, lower, upper, acc, dt, i, out_t)
+        _integrate_row(poses, out_t, dt, i, out_p)
+
+
+class ContactStage:
+    """Exact-footprint contacts at the new poses, walls swept from the previous ones.
+
+    With ``collision_response: stop`` a robot in contact is held at its previous pose with zero
+    twist (its steering unchanged); the contact is reported either way.
+    """
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Nothing to do: the engine tests the contacts of reset worlds itself."""
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Test, respond, and commit the new robot state."""
+        new_p, new_t, new_s = engine.next_poses, engine.next_twists, engine.next_steering
+        old = engine.poses
+        wall, obstacle, agent, robot = engine.contacts.test(
+            new_p, old, engine.ag_off, engine.ag_pos, engine.ag_r,
+            parallel=engine.parallel(engine.num_worlds),
+        )
+        if engine.params.collision_response == "stop":
+            blocked = wall | (np.maximum(np.maximum(obstacle, agent), robot) >= 0)
+            if blocked.any():
+                new_p[blocked] = old[blocked]
+                new_t[blocked] = 0.0
+                new_s[blocked] = engine.steering[blocked]
+        engine.poses, engine.twists, engine.steering = new_p, new_t, new_s
+        engine.wall, engine.obstacle, engine.agent, engine.robot = wall, obstacle, agent, robot
+        engine.commands = commands.copy()  # the caller may reuse its array
+
+
+class SensorStage:
+    """Lidar scans of the sensor rows whose period elapsed; the others hold their last scan.
+
+    Noise is added per world from that world's sensor stream: one ``(1, beams)`` normal draw
+    per due scan with ``noise_std > 0``, in sensor-row order (as ``Lidar2D.scan`` draws).
+    """
+
+    def __init__(self) -> None:
+        self._scene = SceneBuilder()
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Nothing to do: the engine scans reset worlds through :meth:`scan`."""
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Scan the due rows (a 10 Hz lidar in a faster simulation holds its scan)."""
+        if not engine.params.lidar:
+            return
+        times = engine.time
+        last = engine.last_scan
+        period = engine.scan_period
+        due = [
+            not times[w] - last[s] < period[s] - 1e-9
+            for s, w in enumerate(engine.sensor_world)
+        ]
+        if any(due):
+            self.scan(engine, np.array(due, dtype=bool))
+
+    def scan(self, engine: Engine, due: NDArray[np.bool_]) -> None:
+        """Scan the rows of ``due`` ``(S,)`` now (their hold restarts)."""
+        if not engine.params.lidar or not due.any():
+            return
+        p = engine.params
+        off = engine.robot_off
+        scene = self._scene.build(
+            [pedestrian_circles(a, engine.walked[w], p) for w, a in enumerate(engine.agents)],
+            off, engine.poses, engine.radii, engine.placed_polygons(),
+        )
+        parallel = engine.parallel(int(due.sum()))
+        chunk = numba.set_parallel_chunksize(p.parallel_chunksize) if parallel else None
+        try:
+            engine.lidars.scan(due, engine.poses, scene, parallel=parallel)
+        finally:
+            if chunk is not None:
+                numba.set_parallel_chunksize(chunk)
+        scans = list(engine.scans)
+        for s in np.flatnonzero(due).tolist():
+            w = int(engine.sensor_world[s])
+            engine.last_scan[s] = engine.time[w]
+            out = engine.lidars.ranges(s).copy()
+            spec = engine.specs[s]
+            if spec.noise_std > 0.0:
+                row = out[None]
+                z = engine.sensor_rng[w].standard_normal(row.shape)
+                _add_noise(row, z, spec.noise_std, spec.range_min, spec.range_max)
+            scans[s] = out
+        engine.scans = scans
+
+
+def check_step(n: int, commands: F64, dt: float) -> F64:
+    """``commands`` as a float64 ``(n, 3)`` array, or :class:`SimulationError`."""
+    cmd = np.asarray(commands, dtype=np.float64)
+    if cmd.shape != (n, 3):
+        raise SimulationError(f"commands must have shape ({n}, 3) [vx, vy, omega], got {cmd.shape}")
+    # math.isfinite over the few values: a fraction of the cost of np.isfinite(...).all()
+    if not all(map(math.isfinite, cmd.ravel().tolist())):
+        raise SimulationError(f"commands must be finite, got {cmd.tolist()}")
+    if not dt > 0:
+        raise SimulationError(f"dt must be > 0 s, got {dt}")
+    if not math.isfinite(dt):
+        raise SimulationError(f"dt must be a finite number > 0, got {dt!r}")
+    return cmd
