@@ -26,7 +26,7 @@ import os
 
 for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(var, "1")
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # see arena/sim/batch: spinning threads
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # see arena/sim/engine: spinning threads
 
 import argparse  # noqa: E402
 import sys  # noqa: E402

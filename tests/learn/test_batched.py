@@ -233,7 +233,7 @@ def test_world_equals_social_nav_env_on_the_same_episode(extra) -> None:
     robot = None if any(e.startswith("robot=") for e in extra) else small_robot()
     cfg = small_cfg("learning.env.max_steps=200", *extra)
     env = BatchedSocialNavEnv(cfg, robot=robot, num_envs=3)
-    obs, info = env.reset(seed=9)
+    obs, _ = env.reset(seed=9)
     acts = actions(env, 40, seed=3)
     peds_moved = False
     for i in range(3):

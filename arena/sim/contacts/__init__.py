@@ -16,7 +16,8 @@ if _NAME not in sys.modules:
     _spec = importlib.util.spec_from_file_location(
         _NAME, Path(__file__).parent.parent / "native2d" / "collisions.py"
     )
-    assert _spec is not None and _spec.loader is not None
+    assert _spec is not None
+    assert _spec.loader is not None
     _mod = importlib.util.module_from_spec(_spec)
     sys.modules[_NAME] = _mod
     _spec.loader.exec_module(_mod)
