@@ -15,7 +15,6 @@ from arena.sim.engine import EngineParams
 from tests.sim.engine.helpers import episodes, lock_step
 
 
-
 @pytest.mark.parametrize("model", CROWD_MODELS.names())
 def test_every_crowd_model(model: str) -> None:
     peds = {"social_states": "true", "initial_levels": "random"} if model == "pysocial" else {
