@@ -68,13 +68,14 @@ class LidarBank:
         self, due: NDArray[np.bool_], poses: F64, scene: DynamicScene, *, parallel: bool = False
     ) -> None:
         """Cast the due rows; a row ignores the circles and segments its own robot owns."""
-        for s in np.flatnonzero(due).tolist():
+        for s in [i for i, d in enumerate(due.tolist()) if d]:
             w, r = self._row_world[s], self._row_robot[s]
             c0, c1 = int(scene.circ_off[w]), int(scene.circ_off[w + 1])
             k0, k1 = int(scene.seg_off[w]), int(scene.seg_off[w + 1])
             cxy, cr = scene.circ_xy[c0:c1], scene.circ_r[c0:c1]
             own = scene.circ_owner[c0:c1]
-            if c1 > c0 and (own == r).any():
+            # robots' circles come after the people's: none owned when the last is nobody's
+            if c1 > c0 and own[-1] >= 0 and (own == r).any():
                 keep = own != r
                 cxy, cr = cxy[keep], cr[keep]
             sa: F64 | None = None

@@ -142,12 +142,14 @@ class Engine:
         self.agent = np.zeros(0, dtype=np.int64)
         self.robot = np.zeros(0, dtype=np.int64)
         self._multi = np.zeros(0, dtype=bool)  # the row's world holds several robots
+        self._no_polygons: list[F64 | None] | None = []
         self.next_poses = self.poses
         self.next_twists = self.twists
         self.next_steering = self.steering
         # sensor rows
         self.sensor_off = np.zeros(w_n + 1, dtype=np.int64)
         self.sensor_world = np.zeros(0, dtype=np.int64)
+        self.sensor_world_list: list[int] = []  # the same as Python ints (per-step loops)
         self.sensor_robot = np.zeros(0, dtype=np.int64)
         self.specs: list[LidarSpec] = []
         self.scan_period: list[float] = []
@@ -293,6 +295,9 @@ class Engine:
         counts = np.diff(robot_off)
         self.row_world = np.repeat(np.arange(self.num_worlds, dtype=np.int64), counts)
         self._multi = counts[self.row_world] > 1
+        self._no_polygons: list[F64 | None] | None = (
+            None if self._multi.any() else [None] * len(self.row_world)
+        )
         self.poses = np.concatenate(poses)
         self.twists = np.concatenate(twists)
         self.steering = np.concatenate(steer)
@@ -306,6 +311,7 @@ class Engine:
         self.radii = np.array([fp.radius for fp in fps], dtype=np.float64)
         self.sensor_off = sensor_off
         self.sensor_world = np.array(s_world, dtype=np.int64)
+        self.sensor_world_list = s_world
         self.sensor_robot = np.array(s_robot, dtype=np.int64)
         self.specs = s_specs
         self.scan_period = [1.0 / s.update_rate for s in s_specs]
@@ -354,8 +360,11 @@ class Engine:
         self._padded = None
 
     def _tick(self, dt: float) -> None:
-        self.time = [t + dt for t in self.time]
-        self.step_count = [k + 1 for k in self.step_count]
+        """Advance every world's clock (lists of the engine's own, never handed out)."""
+        time, count = self.time, self.step_count
+        for w in range(self.num_worlds):
+            time[w] += dt
+            count[w] += 1
 
     def teleport(self, w: int, robot: int, pose: Pose2D) -> None:
         """Move robot ``robot`` of world ``w`` to ``pose`` at rest; time does not advance.
@@ -414,7 +423,8 @@ class Engine:
         self._padded = None
         if self.num_worlds == 1:
             a = self.agents[0]
-            self.ag_off = np.array([0, len(a)], dtype=np.int64)
+            if self.ag_off[1] != len(a):
+                self.ag_off = np.array([0, len(a)], dtype=np.int64)
             self.ag_pos, self.ag_r = a.positions, a.radii
             return
         counts = [len(a) for a in self.agents]
@@ -427,6 +437,8 @@ class Engine:
 
         ``None`` for a circular robot and for the robot of a one-robot world.
         """
+        if self._no_polygons is not None:  # one robot per world: nobody sees another robot
+            return self._no_polygons
         return [
             fp.world_polygon(self.poses[r]) if multi else None
             for r, (fp, multi) in enumerate(zip(self.footprints, self._multi.tolist(),
@@ -448,30 +460,36 @@ class Engine:
 
     # -- views ---------------------------------------------------------------------------------
     def world_state(self, w: int) -> SimState:
-        """World ``w``'s snapshot (copies the engine never writes into)."""
+        """World ``w``'s snapshot: copies, or arrays the engine never writes into."""
         snap = self._snapshots[w]
         if snap is not None:
             return snap
         if not self._ready[w]:
             raise SimulationError("the backend has not been reset with an episode yet")
-        a, b = int(self.robot_off[w]), int(self.robot_off[w + 1])
-        s0, s1 = int(self.sensor_off[w]), int(self.sensor_off[w + 1])
         scans = self.scans
-        robots = RobotStates(
-            names=self._names[w],
-            models=self._models[w],
-            poses=self.poses[a:b].copy(),
-            twists=self.twists[a:b].copy(),
-            commands=self.commands[a:b].copy(),
-            radii=self.radii[a:b].copy(),
-            footprints=self._polys[w],
-            scans=(scans[s0].copy(),) if s1 - s0 == 1
-            else tuple(s.copy() for s in scans[s0:s1]),
-        )
-        collisions = Collisions(
-            self.wall[a:b].copy(), self.obstacle[a:b].copy(), self.agent[a:b].copy(),
-            self.robot[a:b].copy(),
-        )
+        if self.num_worlds == 1:
+            # Every row is world 0's. The commands and contact flags are arrays of this step
+            # that the engine replaces and never reads back into the simulation: shared.
+            robots = RobotStates(
+                names=self._names[0], models=self._models[0], poses=self.poses.copy(),
+                twists=self.twists.copy(), commands=self.commands, radii=self.radii.copy(),
+                footprints=self._polys[0],
+                scans=(scans[0].copy(),) if len(scans) == 1 else tuple(s.copy() for s in scans),
+            )
+            collisions = Collisions(self.wall, self.obstacle, self.agent, self.robot)
+        else:
+            rows = slice(int(self.robot_off[w]), int(self.robot_off[w + 1]))
+            s0, s1 = int(self.sensor_off[w]), int(self.sensor_off[w + 1])
+            robots = RobotStates(
+                names=self._names[w], models=self._models[w], poses=self.poses[rows].copy(),
+                twists=self.twists[rows].copy(), commands=self.commands[rows].copy(),
+                radii=self.radii[rows].copy(), footprints=self._polys[w],
+                scans=tuple(s.copy() for s in scans[s0:s1]),
+            )
+            collisions = Collisions(
+                self.wall[rows].copy(), self.obstacle[rows].copy(), self.agent[rows].copy(),
+                self.robot[rows].copy(),
+            )
         snap = SimState(self.time[w], self.step_count[w], robots, self.agents[w], collisions)
         self._snapshots[w] = snap
         return snap

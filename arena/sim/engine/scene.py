@@ -93,6 +93,7 @@ class SceneBuilder:
 
     def __init__(self) -> None:
         self._owners: dict[int, I64] = {}  # ``-1`` arrays by length (never written)
+        self._off1 = np.zeros(2, dtype=np.int64)  # ``[0, m]``: one world's offsets (never written)
 
     def _nobody(self, n: int) -> I64:
         a = self._owners.get(n)
@@ -126,8 +127,10 @@ class SceneBuilder:
         if w_n == 1 and robot_off[1] - robot_off[0] <= 1:  # the common single-robot world
             cxy, cr = peds[0]
             m = cr.shape[0]
+            if self._off1[1] != m:
+                self._off1 = np.array([0, m], dtype=np.int64)
             return DynamicScene(
-                np.array([0, m], dtype=np.int64), cxy, cr, self._nobody(m),
+                self._off1, cxy, cr, self._nobody(m),
                 _ZERO_OFF_1, _EMPTY_XY, _EMPTY_XY, _EMPTY_I,
             )
         c_xy: list[F64] = []
