@@ -1,4 +1,4 @@
-"""native2d step rate (the engine with one world): a jackal (720 beams, 30 m) among 30 walking people and 20 obstacles.
+"""native2d (the engine, one world) step rate: a jackal (720 beams) among 30 people, 20 obstacles.
 
     python benchmarks/sim_step.py [--steps 5000]
 

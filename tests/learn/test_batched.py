@@ -177,7 +177,7 @@ def test_driving_into_a_wall_collides_like_social_nav_env() -> None:
 
 def test_sb3_vec_env() -> None:
     pytest.importorskip("stable_baselines3")
-    from arena.learn.batched import SB3VecEnv
+    from arena.learn.sb3_vec import SB3VecEnv
 
     venv = SB3VecEnv(small_cfg("learning.env.max_steps=5"), robot=small_robot(), num_envs=3)
     venv.seed(1)

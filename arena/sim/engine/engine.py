@@ -236,7 +236,11 @@ class Engine:
 
     def _rebuild_rows(self, loaded: dict[int, tuple[Episode, list[RobotModel]]]) -> None:
         """New flat robot and sensor rows: loaded worlds fresh, the others as they were."""
-        poses, twists, steer, cmds, flags = [], [], [], [], []
+        poses: list[F64] = []
+        twists: list[F64] = []
+        steer: list[F64] = []
+        cmds: list[F64] = []
+        flags: list[tuple[B1, I64, I64, I64]] = []
         fps: list[Footprint] = []
         kins: list[Kinematics] = []
         polys_w: list[tuple[F64 | None, ...]] = []
@@ -247,8 +251,8 @@ class Engine:
         s_world: list[int] = []
         robot_off = np.zeros(self.num_worlds + 1, dtype=np.int64)
         sensor_off = np.zeros(self.num_worlds + 1, dtype=np.int64)
+        row0 = 0
         for w in range(self.num_worlds):
-            row0 = sum(len(p) for p in poses)
             if w in loaded:
                 ep, models = loaded[w]
                 n = len(models)
@@ -288,16 +292,15 @@ class Engine:
                 s_scans.extend(self.scans[s0:s1])
                 s_robot.extend(int(r) - a + row0 for r in self.sensor_robot[s0:s1])
                 s_world.extend([w] * (s1 - s0))
-            robot_off[w + 1] = row0 + len(poses[-1])
+            row0 += len(poses[-1])
+            robot_off[w + 1] = row0
             sensor_off[w + 1] = len(s_specs)
         self._polys = polys_w
         self.robot_off = robot_off
         counts = np.diff(robot_off)
         self.row_world = np.repeat(np.arange(self.num_worlds, dtype=np.int64), counts)
         self._multi = counts[self.row_world] > 1
-        self._no_polygons: list[F64 | None] | None = (
-            None if self._multi.any() else [None] * len(self.row_world)
-        )
+        self._no_polygons = None if self._multi.any() else [None] * len(self.row_world)
         self.poses = np.concatenate(poses)
         self.twists = np.concatenate(twists)
         self.steering = np.concatenate(steer)

@@ -110,7 +110,7 @@ class SceneBuilder:
         peds: Sequence[tuple[F64, F64]],
         robot_off: I64,
         poses: F64,
-        radii: Sequence[float],
+        radii: F64,
         polygons: Sequence[F64 | None],
     ) -> DynamicScene:
         """The scene of all worlds.

@@ -87,7 +87,7 @@ class KinematicsStage:
         """Regroup the rows by model (a task generator hands every episode the same model)."""
         groups: dict[tuple[str, str], tuple[Kinematics, list[int]]] = {}
         for row, kin in enumerate(engine.kinematics):
-            key = (kin.name, repr(kin.params))  # type: ignore[attr-defined]
+            key = (kin.name, repr(kin.params))
             groups.setdefault(key, (kin, []))[1].append(row)
         self._groups = [
             (kin, np.array(rows, dtype=np.int64), getattr(kin, "box_limits", None))
@@ -169,8 +169,10 @@ def _hold_blocked(
     wall: NDArray[np.bool_], obstacle: I64, agent: I64, robot: I64, old_p: F64, old_s: F64,
     new_p: F64, new_t: F64, new_s: F64,
 ) -> None:
-    """``collision_response: stop``: rows in contact keep their previous pose and steering, at
-    rest (one compiled pass instead of half a dozen small array operations per step)."""
+    """``collision_response: stop``: rows in contact keep their pose and steering, at rest.
+
+    One compiled pass instead of half a dozen small array operations per step.
+    """
     for i in range(wall.shape[0]):
         if wall[i] or obstacle[i] >= 0 or agent[i] >= 0 or robot[i] >= 0:
             for k in range(3):
