@@ -126,9 +126,11 @@ class Engine:
         self._models: list[tuple[str, ...]] = [()] * w_n
         self._polys: list[tuple[F64 | None, ...]] = [()] * w_n
         self._ready = [False] * w_n
+        self._all_ready = False
         self._snapshots: list[SimState | None] = [None] * w_n
         # robot rows
         self.robot_off = np.zeros(w_n + 1, dtype=np.int64)
+        self._robot_off_l = [0] * (w_n + 1)
         self.row_world = np.zeros(0, dtype=np.int64)
         self.poses = np.zeros((0, 3))
         self.twists = np.zeros((0, 3))
@@ -148,6 +150,7 @@ class Engine:
         self.next_steering = self.steering
         # sensor rows
         self.sensor_off = np.zeros(w_n + 1, dtype=np.int64)
+        self._sensor_off_l = [0] * (w_n + 1)
         self.sensor_world = np.zeros(0, dtype=np.int64)
         self.sensor_world_list: list[int] = []  # the same as Python ints (per-step loops)
         self.sensor_robot = np.zeros(0, dtype=np.int64)
@@ -232,6 +235,7 @@ class Engine:
         self.step_count[w] = 0
         self._snapshots[w] = None
         self._ready[w] = True
+        self._all_ready = all(self._ready)
         return [r.model for r in robots]
 
     def _rebuild_rows(self, loaded: dict[int, tuple[Episode, list[RobotModel]]]) -> None:
@@ -297,6 +301,7 @@ class Engine:
             sensor_off[w + 1] = len(s_specs)
         self._polys = polys_w
         self.robot_off = robot_off
+        self._robot_off_l = robot_off.tolist()  # the same as Python ints
         counts = np.diff(robot_off)
         self.row_world = np.repeat(np.arange(self.num_worlds, dtype=np.int64), counts)
         self._multi = counts[self.row_world] > 1
@@ -313,6 +318,7 @@ class Engine:
         self.kinematics = kins
         self.radii = np.array([fp.radius for fp in fps], dtype=np.float64)
         self.sensor_off = sensor_off
+        self._sensor_off_l = sensor_off.tolist()
         self.sensor_world = np.array(s_world, dtype=np.int64)
         self.sensor_world_list = s_world
         self.sensor_robot = np.array(s_robot, dtype=np.int64)
@@ -351,7 +357,7 @@ class Engine:
     # -- stepping ------------------------------------------------------------------------------
     def step(self, commands: F64, dt: float) -> None:
         """Advance every world by ``dt`` s with ``(R, 3)`` body-twist commands."""
-        if not all(self._ready):
+        if not self._all_ready:
             missing = [w for w, ok in enumerate(self._ready) if not ok]
             raise SimulationError(f"step() called before reset() of worlds {missing}")
         cmd = check_step(self.poses.shape[0], commands, dt)
@@ -453,8 +459,8 @@ class Engine:
         snap = self._snapshots[w]
         if snap is not None:
             return snap.robots
-        a, b = int(self.robot_off[w]), int(self.robot_off[w + 1])
-        s0, s1 = int(self.sensor_off[w]), int(self.sensor_off[w + 1])
+        a, b = self._robot_off_l[w], self._robot_off_l[w + 1]
+        s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
         return RobotStates(
             names=self._names[w], models=self._models[w], poses=self.poses[a:b],
             twists=self.twists[a:b], commands=self.commands[a:b], radii=self.radii[a:b],
@@ -481,8 +487,8 @@ class Engine:
             )
             collisions = Collisions(self.wall, self.obstacle, self.agent, self.robot)
         else:
-            rows = slice(int(self.robot_off[w]), int(self.robot_off[w + 1]))
-            s0, s1 = int(self.sensor_off[w]), int(self.sensor_off[w + 1])
+            rows = slice(self._robot_off_l[w], self._robot_off_l[w + 1])
+            s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
             robots = RobotStates(
                 names=self._names[w], models=self._models[w], poses=self.poses[rows].copy(),
                 twists=self.twists[rows].copy(), commands=self.commands[rows].copy(),

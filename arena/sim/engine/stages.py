@@ -230,17 +230,22 @@ class SensorStage:
         """Scan sensor rows ``rows`` (ascending), add their noise, restart their hold."""
         p = engine.params
         due = self._due(len(engine.specs), rows)
-        scene = self._scene.build(
-            [pedestrian_circles(a, engine.walked[w], p) for w, a in enumerate(engine.agents)],
-            engine.robot_off, engine.poses, engine.radii, engine.placed_polygons(),
+        agents, walked = engine.agents, engine.walked
+        peds = (
+            [pedestrian_circles(agents[0], walked[0], p)] if len(agents) == 1
+            else [pedestrian_circles(a, walked[w], p) for w, a in enumerate(agents)]
         )
-        parallel = engine.parallel(len(rows))
-        chunk = numba.set_parallel_chunksize(p.parallel_chunksize) if parallel else None
-        try:
-            engine.lidars.scan(due, engine.poses, scene, parallel=parallel)
-        finally:
-            if chunk is not None:
+        scene = self._scene.build(
+            peds, engine.robot_off, engine.poses, engine.radii, engine.placed_polygons()
+        )
+        if len(rows) >= p.parallel_min_worlds and numba.get_num_threads() > 1:
+            chunk = numba.set_parallel_chunksize(p.parallel_chunksize)
+            try:
+                engine.lidars.scan(due, engine.poses, scene, parallel=True)
+            finally:
                 numba.set_parallel_chunksize(chunk)
+        else:
+            engine.lidars.scan(due, engine.poses, scene)
         scans = list(engine.scans)
         world_of = engine.sensor_world_list
         for s in rows:
