@@ -74,7 +74,7 @@ def lock_step(
 
     World ``w`` plays ``eps[w]``; with ``reset_at``, world 1 (if any, else 0) restarts with
     ``eps[-1]`` at that step. Returns what happened: ``collided``, ``people_moved``,
-    ``states_seen`` (a social state other than 0).
+    ``states_seen`` (a social state other than 0), ``groups`` (some people walk in groups).
     """
     worlds = len(eps) - (1 if reset_at is not None else 0)
     eng = Engine(worlds, params)
@@ -89,7 +89,7 @@ def lock_step(
     for w in range(worlds):
         assert_same_state(eng.world_state(w), refs[w].state, f"world {w} reset")
     rng = np.random.default_rng(11)
-    seen = {"collided": False, "people_moved": False, "states_seen": False}
+    seen = {"collided": False, "people_moved": False, "states_seen": False, "groups": False}
     first = [eng.world_state(w).agents.positions.copy() for w in range(worlds)]
     for k in range(steps):
         if reset_at is not None and k == reset_at:
@@ -106,6 +106,9 @@ def lock_step(
             assert_same_state(got, refs[w].state, f"world {w} step {k}")
             seen["collided"] |= bool(got.collisions.any.any())
             seen["states_seen"] |= bool(np.any(got.agents.states != 0))
+            drv = eng.drivers[w]
+            if isinstance(drv, CrowdSimulator):
+                seen["groups"] |= bool(np.any(drv.state.group >= 0))
             if got.agents.positions.shape == first[w].shape:
                 seen["people_moved"] |= bool(np.any(got.agents.positions != first[w]))
     return seen

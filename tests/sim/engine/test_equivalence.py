@@ -24,7 +24,7 @@ def test_every_crowd_model(model: str) -> None:
     if model != "spinny":  # spinny turns people on the spot
         assert seen["people_moved"], model
     if model == "pysocial":
-        assert seen["states_seen"]
+        assert seen["states_seen"] and seen["groups"]
 
 
 @pytest.mark.parametrize("robot", ["jackal", "burger", "ridgeback", "f1tenth", "go1"])
