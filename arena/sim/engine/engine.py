@@ -24,8 +24,9 @@ the thread count.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numba
 import numpy as np
@@ -54,6 +55,7 @@ from arena.sim.engine.stages import (
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 B1 = NDArray[np.bool_]
+T = TypeVar("T")
 
 
 @dataclass(frozen=True, eq=False)
@@ -195,6 +197,8 @@ class Engine:
                 raise SimulationError(f"no world {w}: worlds are 0..{self.num_worlds - 1}")
         if len(set(idx)) != len(idx):
             raise SimulationError(f"a world is reset twice in one call: {idx}")
+        if not all(ep.robots for ep in episodes):  # before any world changes
+            raise SimulationError("an episode needs at least one robot")
         loaded: dict[int, tuple[Episode, list[RobotModel]]] = {}
         for w, ep, driver, rng in zip(idx, episodes, drivers, rngs, strict=True):
             loaded[w] = (ep, self._load(w, ep, driver, rng))
@@ -203,10 +207,9 @@ class Engine:
         for stage in self.stages:
             stage.reset_worlds(self, idx)
         fresh = np.isin(self.row_world, idx)
-        wall, obstacle, agent, robot = self.contacts.test(
-            self.poses, None, self.ag_off, self.ag_pos, self.ag_r, rows=fresh,
-            parallel=self.parallel(len(idx)),
-        )
+        wall, obstacle, agent, robot = self.in_pool(len(idx), lambda parallel: self.contacts.test(
+            self.poses, None, self.ag_off, self.ag_pos, self.ag_r, rows=fresh, parallel=parallel,
+        ))
         self._merge_flags(fresh, wall, obstacle, agent, robot)
         self.sensor_stage.scan(self, np.isin(self.sensor_world, idx))
 
@@ -215,8 +218,6 @@ class Engine:
     ) -> list[RobotModel]:
         """Per-world state of episode ``ep`` in world ``w``; returns its robot models."""
         robots = ep.robots
-        if not robots:
-            raise SimulationError("an episode needs at least one robot")
         world = StaticWorld.build(ep.grid, ep.obstacles)
         self.static_worlds[w] = world
         self.contacts.bind_world(w, world)
@@ -426,6 +427,21 @@ class Engine:
         A pool launch costs tens of µs (more on busy cores), more than one world's work.
         """
         return worlds >= self.params.parallel_min_worlds and numba.get_num_threads() > 1
+
+    def in_pool(self, worlds: int, call: Callable[[bool], T]) -> T:
+        """``call(parallel)``, on numba's thread pool (with ``parallel_chunksize``) if worth it.
+
+        Worlds differ in cost (a scan in a corridor ends sooner than one across a hall) and a
+        shared core may stall one thread: with dynamic chunks the other threads take the rest.
+        Which thread steps a world never changes its result.
+        """
+        if not self.parallel(worlds):
+            return call(False)
+        previous = numba.set_parallel_chunksize(self.params.parallel_chunksize)
+        try:
+            return call(True)
+        finally:
+            numba.set_parallel_chunksize(previous)
 
     def gather_agents(self) -> None:
         """The flat pedestrian arrays from each world's :class:`AgentStates`."""

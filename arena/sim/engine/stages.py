@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Protocol
 
-import numba
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
@@ -141,9 +140,12 @@ class ContactStage:
         """Test, respond, and commit the new robot state."""
         new_p, new_t, new_s = engine.next_poses, engine.next_twists, engine.next_steering
         old = engine.poses
-        wall, obstacle, agent, robot = engine.contacts.test(
-            new_p, old, engine.ag_off, engine.ag_pos, engine.ag_r,
-            parallel=engine.parallel(engine.num_worlds),
+        ag_off, ag_pos, ag_r = engine.ag_off, engine.ag_pos, engine.ag_r
+        wall, obstacle, agent, robot = engine.in_pool(
+            engine.num_worlds,
+            lambda parallel: engine.contacts.test(
+                new_p, old, ag_off, ag_pos, ag_r, parallel=parallel
+            ),
         )
         # one small compiled test first: contacts are rare, the response's nine arguments
         # cost more to pass than the test
@@ -238,14 +240,10 @@ class SensorStage:
         scene = self._scene.build(
             peds, engine.robot_off, engine.poses, engine.radii, engine.placed_polygons()
         )
-        if len(rows) >= p.parallel_min_worlds and numba.get_num_threads() > 1:
-            chunk = numba.set_parallel_chunksize(p.parallel_chunksize)
-            try:
-                engine.lidars.scan(due, engine.poses, scene, parallel=True)
-            finally:
-                numba.set_parallel_chunksize(chunk)
-        else:
-            engine.lidars.scan(due, engine.poses, scene)
+        poses = engine.poses
+        engine.in_pool(
+            len(rows), lambda parallel: engine.lidars.scan(due, poses, scene, parallel=parallel)
+        )
         scans = list(engine.scans)
         world_of = engine.sensor_world_list
         for s in rows:
