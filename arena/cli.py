@@ -507,7 +507,7 @@ def train(
     ``--export RUN/checkpoints/step_N`` writes the policy of an earlier checkpoint.
     """
     # before numba/OpenMP start threads: idle workers sleep instead of spinning, so that the
-    # batched simulator's parallel loops do not steal cores from torch (see arena.sim.batch)
+    # batched engine's parallel loops do not steal cores from torch (see arena.sim.engine)
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
     from datetime import datetime
 

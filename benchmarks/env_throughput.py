@@ -1,6 +1,7 @@
 """RL environment throughput: env steps/s for one SocialNavEnv and the batched vector env.
 
     python benchmarks/env_throughput.py [--steps 10000] [--worlds 16 64] [--threads 2]
+        [--crowds waypoint_walker pysocial]
 
 The issue-7 setup: a jackal (720 beams, 30 m) among 20 pedestrians on the packaged
 ``small_office`` world with 4 static obstacles; default observation (lidar + goal + last
@@ -9,15 +10,19 @@ resets included (an episode ends on arrival, contact, the 60 s timeout or 500 st
 
 * ``single``: one :class:`~arena.learn.env.SocialNavEnv` (native2d, the full crowd with social
   states, the reference simulator), one core.
-* ``batched N``: :class:`~arena.learn.batched.BatchedSocialNavEnv` with ``N`` worlds stepped
-  together (batched lidar/contacts/social-force kernels), ``--threads`` numba threads, the next
-  episode of each world drawn ahead by one helper process (``--prefetch 1``, as training does;
-  ``--prefetch 0`` draws in-process); the figure is the sum over worlds (N env steps per call).
+* ``batched N, crowd C``: :class:`~arena.learn.batched.BatchedSocialNavEnv` with ``N`` worlds
+  of the one engine (the simulation of ``single``, batched), ``--threads`` numba threads, the
+  next episode of each world drawn ahead by one helper process (``--prefetch 1``, as training
+  does; ``--prefetch 0`` draws in-process); the figure is the sum over worlds (N env steps per
+  call). ``--crowds`` names the crowds measured: ``none`` (no people), ``pysocial`` (the full
+  crowd: social states and groups on, as ``single``), or any other crowd model (social states
+  off).
 
 Each setup is measured ``--repeat`` times (default 3) and the median printed, with the range:
 on a shared 2-core host the same code varies by a third from one minute to the next.
 
-Targets (issue 7, 2 cores): >= 3,000 steps/s single, >= 20,000 steps/s batched (16 and 64).
+Targets (issues 7 and 18, 2 cores): >= 3,000 steps/s single; batched N = 64 >= 20,000 steps/s
+with a fast crowd, and (aim) >= 10,000 with the full pysocial crowd.
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ import os
 
 for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(var, "1")
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # see arena/sim/batch: spinning threads
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # see arena/sim/engine: spinning threads
 
 import argparse  # noqa: E402
 import sys  # noqa: E402
@@ -63,11 +68,22 @@ def single(steps: int) -> float:
     return steps / (time.perf_counter() - t0)
 
 
-def batched(n: int, steps: int, prefetch: int, repeat: int) -> list[float]:
+def crowd_overrides(crowd: str) -> list[str]:
+    """The config overrides of a ``--crowds`` entry."""
+    if crowd == "none":
+        return ["task.obstacles.dynamic=0"]
+    if crowd == "pysocial":
+        return ["crowd={type: pysocial}", "pedestrians.social_states=true"]
+    return [f"crowd={{type: {crowd}}}", "pedestrians.social_states=false"]
+
+
+def batched(n: int, steps: int, prefetch: int, repeat: int, crowd: str) -> list[float]:
     """``repeat`` measurements of ``steps`` env steps each, one after the other on one env."""
     from arena.learn.batched import BatchedSocialNavEnv
 
-    env = BatchedSocialNavEnv(None, OVERRIDES, num_envs=n, prefetch=prefetch)
+    env = BatchedSocialNavEnv(
+        None, [*OVERRIDES, *crowd_overrides(crowd)], num_envs=n, prefetch=prefetch
+    )
     try:
         env.reset(seed=0)
         env.action_space.seed(0)
@@ -98,6 +114,8 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3,
                     help="measurements per setup; the median is the figure (shared hosts vary)")
     ap.add_argument("--skip-single", action="store_true")
+    ap.add_argument("--crowds", nargs="+", default=["waypoint_walker", "pysocial"],
+                    help="batched: crowds measured (none, pysocial = full, or a model name)")
     ap.add_argument("--prefetch", type=int, default=1,
                     help="batched: episodes per world drawn ahead by a helper process "
                     "(learning.train.prefetch_episodes; 0: drawn in-process)")
@@ -115,10 +133,12 @@ def main() -> None:
         rates = [single(args.steps) for _ in range(args.repeat)]
         show("single SocialNavEnv (native2d, 1 core):", rates, "3,000")
     numba.set_num_threads(min(args.threads, numba.config.NUMBA_NUM_THREADS))
-    for n in args.worlds:
-        rates = batched(n, max(args.steps, 20 * n), args.prefetch, args.repeat)
-        show(f"BatchedSocialNavEnv N={n} ({numba.get_num_threads()} threads, prefetch "
-             f"{args.prefetch}):", rates, "20,000")
+    for crowd in args.crowds:
+        for n in args.worlds:
+            rates = batched(n, max(args.steps, 20 * n), args.prefetch, args.repeat, crowd)
+            target = "10,000" if crowd == "pysocial" else "20,000"
+            show(f"Batched N={n} {crowd} ({numba.get_num_threads()} thr, prefetch "
+                 f"{args.prefetch}):", rates, target)
     sys.stdout.flush()
 
 

@@ -1,4 +1,4 @@
-"""native2d step rate: a jackal (720 beams, 30 m) among 30 walking people and 20 obstacles.
+"""native2d (the engine, one world) step rate: a jackal (720 beams) among 30 people, 20 obstacles.
 
     python benchmarks/sim_step.py [--steps 5000]
 
@@ -29,6 +29,7 @@ from arena.maps.grid import OccupancyGrid  # noqa: E402
 from arena.maps.io import save_map  # noqa: E402
 from arena.maps.sources import MapResult  # noqa: E402
 from arena.robots.presets import load_robot  # noqa: E402
+from arena.sensors.lidar2d import Lidar2D  # noqa: E402
 from arena.sim.native2d import Native2DBackend  # noqa: E402
 from arena.tasks.config import TaskConfig  # noqa: E402
 from arena.tasks.generator import TaskGenerator  # noqa: E402
@@ -88,8 +89,10 @@ def main() -> None:
     steps_per_s = args.steps / elapsed
 
     # Lidar alone, same world and pose stream.
-    lidar = backend._lidar[0]
     st = backend.state
+    lidar = Lidar2D(jackal.laser)
+    w = backend.world
+    lidar.bind(w.grid, w.segments_a, w.segments_b)
     poses = np.array([st.robots.poses[0]] * 200)
     poses[:, 2] += np.linspace(0, 2 * np.pi, 200)
     t0 = time.perf_counter()

@@ -1,4 +1,4 @@
-"""``N`` social-navigation worlds as one Gymnasium vector environment, stepped by :class:`BatchSim`.
+"""``N`` social-navigation worlds as one Gymnasium vector environment on one simulation engine.
 
 :class:`BatchedSocialNavEnv` is the vectorised counterpart of
 :class:`~arena.learn.env.SocialNavEnv`: the same observation and action spaces (built by
@@ -6,13 +6,18 @@
 :class:`~arena.learn.actions.ActionDecoder`), the same reward terms
 (:class:`~arena.learn.rewards.RewardFunction`) and the same episode-end rules (terminated on goal
 or collision, truncated after ``max_steps`` env steps or the episode's time limit), all from the
-same :class:`~arena.config.schema.ExperimentConfig`. Every part of an env step runs on arrays
-with a leading world axis; there is one :meth:`BatchSim.step` call per simulation sub-step for
-all worlds, and no Python loop over worlds except to draw the episodes of worlds that restart.
+same :class:`~arena.config.schema.ExperimentConfig`. The worlds are stepped by one
+:class:`~arena.sim.engine.Engine` with ``N`` worlds (one :meth:`Engine.step` per simulation
+sub-step for all of them); the reward, end rules and observations run on arrays with a leading
+world axis.
 
-Differences from ``SocialNavEnv`` (they come from the simulator, see :mod:`arena.sim.batch`):
-pedestrians follow the batched social force (not ``cfg.crowd``), and contacts use the robot's
-circumscribed circle, so trajectories are not those of the native2d backend.
+The simulation is ``native2d``'s own: the engine with one world is the ``native2d`` backend, the
+pedestrians of each world are ``cfg.crowd`` with ``cfg.pedestrians`` (built as ``arena run``
+builds them), contacts use the robot's real footprint, and the engine parameters are those of
+``cfg.sim.backend``. World ``i`` therefore plays its episode exactly as
+:class:`~arena.learn.env.SocialNavEnv` plays the same episode and seed: the same observations,
+rewards and ends (``tests/learn/test_batched.py``), and a policy trains on the crowd it is
+evaluated on.
 
 Episodes: world ``i`` plays the task generator's episodes ``i, i + N, i + 2N, …`` of the current
 seed (``cfg.seed``, or the last ``reset(seed=…)``), each with the simulator stream
@@ -38,6 +43,7 @@ from __future__ import annotations
 import os
 import warnings
 from collections.abc import Sequence
+from dataclasses import dataclass
 from functools import partial
 from typing import Any
 
@@ -47,8 +53,10 @@ from gymnasium.vector.utils import batch_space
 from numpy.typing import NDArray
 
 from arena.config.schema import ExperimentConfig
+from arena.core.errors import ConfigError
 from arena.core.rng import derive_rng
 from arena.core.types import Outcome
+from arena.crowd.driver import build_driver
 from arena.learn.actions import ActionDecoder
 from arena.learn.driver import (
     ConfigLike,
@@ -64,7 +72,8 @@ from arena.maps.raster import planning_grid
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.scene.episode import Episode
-from arena.sim.batch import BatchSim, BatchState
+from arena.sim.backend import BACKENDS
+from arena.sim.engine import Engine, EngineParams
 from arena.tasks.generator import TaskGenerator
 
 F64 = NDArray[np.float64]
@@ -82,7 +91,7 @@ _REASON_COLLISION = int(DoneReason.COLLISION)
 
 
 class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
-    """``num_envs`` single-robot worlds in one :class:`BatchSim`; see the module docstring.
+    """``num_envs`` single-robot worlds in one :class:`Engine`; see the module docstring.
 
     Args:
         config: an :class:`ExperimentConfig`, a YAML path or ``None`` (the packaged default).
@@ -90,7 +99,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         num_envs: ``N``, the number of worlds.
         robot: a preset name or robot YAML path (the config key), or a robot model
             replacing ``cfg.robot``.
-        sim_params: parameters of the batched simulator.
+        sim_params: engine parameters; ``None``: those of ``cfg.sim.backend`` (``native2d``).
         autoreset_mode: ``NEXT_STEP`` (default) or ``SAME_STEP``.
         prefetch: episodes per world drawn ahead by a helper process
             (:class:`~arena.learn.prefetch.EpisodePrefetcher`); 0 (default) draws them in this
@@ -113,7 +122,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         *,
         num_envs: int = 1,
         robot: RobotModel | str | os.PathLike[str] | None = None,
-        sim_params: BatchSim.Params | None = None,
+        sim_params: EngineParams | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         prefetch: int = 0,
         **config_keys: Any,
@@ -145,7 +154,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         self.observation_space = batch_space(self.single_observation_space, n)
         self.action_space = batch_space(self.single_action_space, n)
         self.render_mode = None
-        self.sim = BatchSim(n, sim_params)
+        self.sim = Engine(n, sim_params if sim_params is not None else _engine_params(self.cfg))
         self.seed_value = int(self.cfg.seed)
         self.generator = self._generator(self.seed_value)
         self.radius = float(self.robot.radius)
@@ -161,7 +170,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         self._last_action = np.zeros((n, 3))
         self._autoreset = np.zeros(n, dtype=bool)
         self._outcome: NDArray[np.object_] = np.full(n, None, dtype=object)
-        self._state: BatchState | None = None
+        self._state: _Frame | None = None
         self._ones = np.ones(n, dtype=bool)
         self._arange = np.arange(n)
         self._safe = np.full(n, self.radius + self.env_cfg.safety_distance)
@@ -235,6 +244,31 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             self._request_next(worlds)
         return eps, rngs
 
+    def _reset_worlds(self, worlds: NDArray[np.int64]) -> _Frame:
+        """Draw and start the next episode of each world in ``worlds``; the frame after it."""
+        eps, rngs = self._draw(worlds.tolist())
+        for ep in eps:
+            if len(ep.robots) != 1:
+                raise ConfigError(
+                    f"task.robots: BatchedSocialNavEnv worlds hold one robot, the task placed "
+                    f"{len(ep.robots)}"
+                )
+        drivers = [build_driver(self.cfg.crowd, self.cfg.pedestrians) for _ in eps]
+        self.sim.reset_worlds(worlds, eps, drivers, rngs)
+        return self._frame()
+
+    def _frame(self) -> _Frame:
+        """What the env reads of the engine now (one robot and one laser per world)."""
+        sim = self.sim
+        peds = sim.padded_agents()
+        first = sim.sensor_off[:-1].tolist()
+        return _Frame(
+            time=np.array(sim.time), poses=sim.poses, twists=sim.twists,
+            scans=np.stack([sim.scans[s] for s in first]),
+            ped_positions=peds.positions, ped_velocities=peds.velocities,
+            ped_kinds=peds.kinds, ped_states=peds.states, ped_mask=peds.mask,
+        )
+
     def _request_next(self, worlds: Sequence[int] | NDArray[np.int64]) -> None:
         """Ask the prefetcher for the next ``prefetch`` episodes of each world in ``worlds``."""
         pre = self._prefetcher
@@ -245,7 +279,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             int(i) + (int(self._k[i]) + a) * n for a in range(self.prefetch) for i in worlds
         )
 
-    def _restart(self, worlds: NDArray[np.int64], state: BatchState) -> None:
+    def _restart(self, worlds: NDArray[np.int64], state: _Frame) -> None:
         """Bookkeeping of freshly reset worlds (state: the snapshot after their reset)."""
         self._steps[worlds] = 0
         self._last_action[worlds] = 0.0
@@ -260,7 +294,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
                 tr.reset(planning_grid(ep), state.poses[i : i + 1], self._goals[i : i + 1], 0.0)
                 self._subgoals[i] = tr.current[0]
 
-    def _update_subgoals(self, state: BatchState, skip: B1 | None = None) -> None:
+    def _update_subgoals(self, state: _Frame, skip: B1 | None = None) -> None:
         """Replan/move each world's subgoal after a step (worlds in ``skip`` restart anyway)."""
         if self.trackers is None:
             return
@@ -292,12 +326,10 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         mask = (options or {}).get("reset_mask")
         if mask is not None and self._state is not None and seed is None:
             worlds = np.flatnonzero(np.asarray(mask, dtype=bool))
-            eps, rngs = self._draw(worlds.tolist())
-            state = self.sim.reset_worlds(worlds, eps, rngs)
+            state = self._reset_worlds(worlds)
         else:
             worlds = self._arange
-            eps, rngs = self._draw(worlds.tolist())
-            state = self.sim.reset(eps, rngs)
+            state = self._reset_worlds(worlds)
         self._state = state
         self._restart(worlds, state)
         obs = self._observe(state)
@@ -320,11 +352,12 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         prev_pose = prev.poses
         d = self._goals - prev_pose[:, :2]
         prev_dist = np.hypot(d[:, 0], d[:, 1])
-        state = self.sim.step(cmd, self.dt)
-        collision = state.collided  # a fresh array of the snapshot
+        self.sim.step(cmd, self.dt)
+        collision = self.sim.collided()  # a fresh array
         for _ in range(self.substeps - 1):
-            state = self.sim.step(cmd, self.dt)
-            collision = collision | state.collided
+            self.sim.step(cmd, self.dt)
+            collision = collision | self.sim.collided()
+        state = self._frame()
         self._steps += 1
         scans = state.scans
         if self._scans.shape[1] > 1:
@@ -366,8 +399,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         if self.autoreset_mode == AutoresetMode.NEXT_STEP:
             if restart.any():
                 worlds = np.flatnonzero(restart)
-                eps, rngs = self._draw(worlds.tolist())
-                state = self.sim.reset_worlds(worlds, eps, rngs)
+                state = self._reset_worlds(worlds)
                 self._state = state
                 self._restart(worlds, state)
                 reward[restart] = 0.0
@@ -393,8 +425,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             info["_final_info"] = done.copy()
             info["final_obs"] = fo
             info["_final_obs"] = done.copy()
-            eps, rngs = self._draw(worlds.tolist())
-            state = self.sim.reset_worlds(worlds, eps, rngs)
+            state = self._reset_worlds(worlds)
             self._state = state
             self._restart(worlds, state)
             fresh = self._info(state)
@@ -403,7 +434,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         return self._observe(state), reward, terminated, truncated, info
 
     def _ends(
-        self, out: RewardOutput, goal_reached: B1, collision: B1, state: BatchState
+        self, out: RewardOutput, goal_reached: B1, collision: B1, state: _Frame
     ) -> tuple[B1, B1, NDArray[np.object_]]:
         """Termination, truncation and outcome per world (the rules of the single env)."""
         reason_collision = out.reason == _REASON_COLLISION
@@ -421,7 +452,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         return terminated, truncated, outcome
 
     # -- observations and info ---------------------------------------------------------------------
-    def _observe(self, state: BatchState) -> Any:
+    def _observe(self, state: _Frame) -> Any:
         n = self.num_envs
         m = state.ped_positions.shape[1]
         goals = self._goals if self.trackers is None else self._subgoals
@@ -455,7 +486,7 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         return obs[i].copy()
 
     def _info(
-        self, state: BatchState, out: RewardOutput | None = None, collision: B1 | None = None
+        self, state: _Frame, out: RewardOutput | None = None, collision: B1 | None = None
     ) -> dict[str, Any]:
         d = self._goals - state.poses[:, :2]
         ones = self._ones
@@ -494,6 +525,36 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
             self._prefetcher = None
 
 
+@dataclass(frozen=True, eq=False)
+class _Frame:
+    """The engine's state as the env reads it; arrays the engine never writes into.
+
+    ``time`` ``(N,)`` s; ``poses``/``twists`` ``(N, 3)``; ``scans`` ``(N, B)`` m (each
+    world's laser); ``ped_*`` ``(N, P, ...)`` padded, valid where ``ped_mask``.
+    """
+
+    time: F64
+    poses: F64
+    twists: F64
+    scans: F64
+    ped_positions: F64
+    ped_velocities: F64
+    ped_kinds: NDArray[np.int64]
+    ped_states: NDArray[np.int64]
+    ped_mask: B1
+
+
+def _engine_params(cfg: ExperimentConfig) -> EngineParams:
+    """The engine parameters of ``cfg.sim.backend`` (``native2d``'s), as ``arena run`` uses."""
+    entry, params = BACKENDS.validate(cfg.sim.backend, path="sim.backend")
+    if entry.name != "native2d" or not isinstance(params, EngineParams):
+        raise ConfigError(
+            f"BatchedSocialNavEnv runs the native2d engine, got {entry.name!r}",
+            path="sim.backend.type",
+        )
+    return params
+
+
 def make_generator(
     cfg: ExperimentConfig, robot: RobotModel, seed: int, stage: int | None
 ) -> TaskGenerator:
@@ -521,106 +582,3 @@ def _seeding(seed: int) -> tuple[np.random.Generator, int]:
     from gymnasium.utils import seeding
 
     return seeding.np_random(seed)
-
-
-# ------------------------------------------------------------------------------------------------
-# Stable-Baselines3 adapter (only when stable-baselines3 is importable)
-# ------------------------------------------------------------------------------------------------
-try:
-    from stable_baselines3.common.vec_env.base_vec_env import VecEnv as _SB3VecEnv
-
-    HAVE_SB3 = True
-except ImportError:  # pragma: no cover - optional dependency
-    HAVE_SB3 = False
-
-
-if HAVE_SB3:
-
-    class SB3VecEnv(_SB3VecEnv):
-        """Stable-Baselines3 ``VecEnv`` over a :class:`BatchedSocialNavEnv` (``SAME_STEP``).
-
-        SB3 conventions: ``reset()`` returns observations only; ``step_wait()`` returns
-        ``(obs, rewards, dones, infos)`` with a list of per-world info dicts; a finished world is
-        reset in the same step, its last observation in ``infos[i]["terminal_observation"]``
-        and ``infos[i]["TimeLimit.truncated"]`` set on truncation. ``seed(s)`` applies at the
-        next ``reset()``.
-
-        Args:
-            config, overrides, num_envs, robot, sim_params, prefetch: as
-                :class:`BatchedSocialNavEnv`.
-        """
-
-        def __init__(
-            self,
-            config: ConfigLike = None,
-            overrides: Sequence[str] = (),
-            *,
-            num_envs: int = 1,
-            robot: RobotModel | None = None,
-            sim_params: BatchSim.Params | None = None,
-            prefetch: int = 0,
-        ) -> None:
-            self.env = BatchedSocialNavEnv(
-                config, overrides, num_envs=num_envs, robot=robot, sim_params=sim_params,
-                autoreset_mode=AutoresetMode.SAME_STEP, prefetch=prefetch,
-            )
-            super().__init__(
-                num_envs, self.env.single_observation_space, self.env.single_action_space
-            )
-            self._actions: Any = None
-
-        def reset(self) -> Any:
-            """Restart every world (with the seed given to :meth:`seed`, if any)."""
-            seed = self._seeds[0] if self._seeds else None
-            obs, _ = self.env.reset(seed=seed)
-            self._reset_seeds()
-            self._reset_options()
-            return obs
-
-        def step_async(self, actions: np.ndarray) -> None:
-            """Remember the actions of the next :meth:`step_wait`."""
-            self._actions = actions
-
-        def step_wait(self) -> Any:
-            """One batched step; finished worlds restart at once (SB3 convention)."""
-            obs, rew, term, trunc, info = self.env.step(self._actions)
-            done = term | trunc
-            n = self.num_envs
-            infos: list[dict[str, Any]] = [{} for _ in range(n)]
-            src = info.get("final_info", info)
-            for i in range(n):
-                d = infos[i]
-                s = src if done[i] else info
-                for k in ("episode_index", "time", "steps", "goal_distance", "outcome",
-                          "collision"):
-                    if k in s:
-                        v = s[k][i]
-                        d[k] = v.item() if isinstance(v, np.generic) else v
-                d["is_success"] = d.get("outcome") == _SUCCESS
-                if done[i]:
-                    d["terminal_observation"] = info["final_obs"][i]
-                    d["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
-            return obs, rew.astype(np.float32), done, infos
-
-        def close(self) -> None:
-            """Close the batched env."""
-            self.env.close()
-
-        def get_attr(self, attr_name: str, indices: Any = None) -> list[Any]:
-            """The batched env's attribute, once per requested world."""
-            return [getattr(self.env, attr_name) for _ in self._get_indices(indices)]
-
-        def set_attr(self, attr_name: str, value: Any, indices: Any = None) -> None:
-            """Set an attribute of the batched env (shared by every world)."""
-            setattr(self.env, attr_name, value)
-
-        def env_method(
-            self, method_name: str, *method_args: Any, indices: Any = None, **method_kwargs: Any
-        ) -> list[Any]:
-            """Call a method of the batched env, once per requested world."""
-            fn = getattr(self.env, method_name)
-            return [fn(*method_args, **method_kwargs) for _ in self._get_indices(indices)]
-
-        def env_is_wrapped(self, wrapper_class: Any, indices: Any = None) -> list[bool]:
-            """No world is wrapped."""
-            return [False for _ in self._get_indices(indices)]

@@ -26,8 +26,8 @@ episode of index ``i`` is the one the env would have drawn itself (tested bit fo
 Transport: episodes are pickled through a pipe to a fresh interpreter (POSIX only). Maps
 (``OccupancyGrid``, ≈ 1.7 MB with its distance map) travel once per map: the helper sends a
 new map in its own message under a token, and later episodes refer to the token (pickle's
-``persistent_id``), so a fixed map is shared by all episodes, as
-:class:`~arena.sim.batch.BatchSim` expects (it keeps one distance-map copy per map object).
+``persistent_id``), so a fixed map is shared by all episodes, as the engine's banks expect
+(they keep one copy of a map's static geometry per map object).
 The robot model travels the same way, once, at start. The helper computes each new map's
 distance transform before sending it, off the main process.
 """

@@ -183,7 +183,7 @@ class TrainConfig(_Strict):
     vec_env: Literal["dummy", "subproc", "batched", "multi_robot"] = Field(
         "subproc",
         description="SB3 vector env; one env always runs in-process; batched: "
-        "BatchedSocialNavEnv (all envs in one BatchSim; evaluation stays on SocialNavEnv); "
+        "BatchedSocialNavEnv (all envs as worlds of one engine; evaluation stays on SocialNavEnv); "
         "multi_robot: MultiRobotVecEnv, one slot per robot of robots_per_world worlds",
     )
     robots_per_world: list[int] | None = Field(

@@ -93,7 +93,7 @@ def make_vec_env(
 ) -> Any:
     """``n_envs`` environments in SB3's ``DummyVecEnv`` or ``SubprocVecEnv``.
 
-    ``kind="batched"``: one :class:`~arena.learn.batched.SB3VecEnv` over a
+    ``kind="batched"``: one :class:`~arena.learn.sb3_vec.SB3VecEnv` over a
     :class:`~arena.learn.batched.BatchedSocialNavEnv` of ``n_envs`` worlds (seeded with
     ``seed`` at its next reset when given; ``prefetch`` episodes per world drawn ahead in a
     helper process). ``kind="multi_robot"``: a
@@ -115,7 +115,7 @@ def make_vec_env(
         return mvenv
 
     if kind == "batched":
-        from arena.learn.batched import SB3VecEnv
+        from arena.learn.sb3_vec import SB3VecEnv
 
         venv = SB3VecEnv(cfg, num_envs=n_envs, robot=robot, prefetch=prefetch)
         if seed is not None:

@@ -177,7 +177,7 @@ def test_driving_into_a_wall_collides_like_social_nav_env() -> None:
 
 def test_sb3_vec_env() -> None:
     pytest.importorskip("stable_baselines3")
-    from arena.learn.batched import SB3VecEnv
+    from arena.learn.sb3_vec import SB3VecEnv
 
     venv = SB3VecEnv(small_cfg("learning.env.max_steps=5"), robot=small_robot(), num_envs=3)
     venv.seed(1)
@@ -218,3 +218,37 @@ def test_subgoal_first_observation_matches_single_env() -> None:
         obs, _, _, _, info = env.step(a)
         assert env.observation_space.contains(obs)
         assert np.all(obs["goal"][:, 0] <= 3.0 + 1.0 + 1e-4)  # horizon + max_deviation
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [
+        ("crowd={type: pysocial}", "pedestrians.social_states=true",
+         "learning.env.observation.pedestrians.enabled=true"),
+        ("crowd={type: orca}", "pedestrians.social_states=false", "robot=burger"),
+    ],
+)
+def test_world_equals_social_nav_env_on_the_same_episode(extra) -> None:
+    """One engine: world i plays episode i exactly as SocialNavEnv (observations, rewards)."""
+    robot = None if any(e.startswith("robot=") for e in extra) else small_robot()
+    cfg = small_cfg("learning.env.max_steps=200", *extra)
+    env = BatchedSocialNavEnv(cfg, robot=robot, num_envs=3)
+    obs, _ = env.reset(seed=9)
+    acts = actions(env, 40, seed=3)
+    peds_moved = False
+    for i in range(3):
+        single = SocialNavEnv(cfg, robot=robot)
+        s_obs, _ = single.reset(seed=9, options={"episode": i})
+        first = single.driver.state.agents.positions.copy()
+        assert _equal({k: v[i] for k, v in obs.items()}, s_obs)
+        b_env = BatchedSocialNavEnv(cfg, robot=robot, num_envs=3)
+        b_obs, _ = b_env.reset(seed=9)
+        for a in acts:
+            b_obs, rew, term, trunc, _ = b_env.step(a)
+            s_obs, s_rew, s_term, s_trunc, _ = single.step(a[i])
+            assert _equal({k: v[i] for k, v in b_obs.items()}, s_obs)
+            assert rew[i] == s_rew and term[i] == s_term and trunc[i] == s_trunc
+            if s_term or s_trunc:
+                break
+        peds_moved |= bool(np.any(single.driver.state.agents.positions != first))
+    assert peds_moved

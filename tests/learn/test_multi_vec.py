@@ -69,7 +69,7 @@ def test_first_finisher_ends_its_world():
     # put robot 0 of world 0 on its goal (a test-only write into native2d's pose array): it
     # succeeds, robot 1 of the same world is cut (truncated), world 1 goes on
     d = venv.worlds[0].driver
-    d.backend._poses[0, :2] = d.goals[0, :2]
+    d.backend.engine.poses[0, :2] = d.goals[0, :2]
     _, _, dones, infos = venv.step(np.zeros((5, 2), np.float32))
     assert dones[0] and dones[1] and not dones[2:].any()
     assert infos[0]["outcome"] == "success" and not infos[0]["TimeLimit.truncated"]
@@ -85,7 +85,7 @@ def test_respawn_restarts_only_the_finisher():
     d = venv.worlds[0].driver
     others = d.state.robots.poses[1].copy()
     old_goal = d.goals[0].copy()
-    d.backend._poses[0, :2] = d.goals[0, :2]  # robot 0 of world 0 arrives (test-only write)
+    d.backend.engine.poses[0, :2] = d.goals[0, :2]  # robot 0 of world 0 arrives (test-only write)
     obs, _, dones, infos = venv.step(np.zeros((5, 2), np.float32))
     # only robot 0's slot ends; its world goes on, robot 1 keeps driving (it stood still)
     assert dones.tolist() == [True, False, False, False, False]

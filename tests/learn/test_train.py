@@ -148,8 +148,8 @@ def test_cli_bad_config_is_one_line(tmp_path):
 
 
 def test_batched_vec_env_run_with_real_evaluator(tmp_path):
-    from arena.learn.batched import SB3VecEnv
     from arena.learn.policy import NumpyPolicy
+    from arena.learn.sb3_vec import SB3VecEnv
     from arena.learn.train import make_vec_env
 
     cfg = small_cfg("task.modules=[{type: staged, curriculum: default}]",

@@ -263,13 +263,13 @@ def test_footprints_are_reused_across_resets(room):
     jackal, burger = load_robot("jackal"), load_robot("burger")
     b = Native2DBackend()
     b.reset(make_episode(room, [(jackal, (2, 5, 0), (8, 5, 0))]), None, np.random.default_rng(0))
-    first = b._footprints[0]
+    first = b.engine.footprints[0]
     want = Footprint.make(jackal.footprint_polygon(), jackal.circumscribed_radius)
     assert first.polygon.tobytes() == want.polygon.tobytes() and first.radius == want.radius
     b.reset(make_episode(room, [(jackal, (3, 5, 0), (8, 5, 0))]), None, np.random.default_rng(1))
-    assert b._footprints[0] is first
+    assert b.engine.footprints[0] is first
     b.reset(make_episode(room, [(burger, (3, 5, 0), (8, 5, 0))]), None, np.random.default_rng(1))
     other = Footprint.make(burger.footprint_polygon(), burger.circumscribed_radius)
-    got = b._footprints[0]
+    got = b.engine.footprints[0]
     assert got is not first and got.radius == other.radius
     assert (got.polygon is None) == (other.polygon is None)

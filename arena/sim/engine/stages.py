@@ -1,0 +1,278 @@
+"""The stages of one engine step, in their fixed order: crowd, kinematics, contacts, sensors.
+
+A stage is an object with ``reset_worlds(engine, worlds)`` (after worlds were (re)loaded: the
+robot and sensor rows may have changed) and ``step(engine, commands, dt)``; the engine holds
+them in a tuple and calls them in order. A later engine (GPU, 3-D) swaps stages, not the loop.
+Each stage reads and replaces the engine's flat arrays (never writes into arrays it handed
+out, so a caller may keep them).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from arena.core.errors import SimulationError
+from arena.robots.kinematics.base import (
+    Kinematics,
+    KinematicState,
+    _box_twist_row,
+    _integrate_row,
+)
+from arena.sensors.lidar2d.kernels import _add_noise
+from arena.sim.engine.scene import SceneBuilder, pedestrian_circles
+
+if TYPE_CHECKING:
+    from arena.sim.engine.engine import Engine
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+
+
+class Stage(Protocol):
+    """One stage of :meth:`Engine.step`."""
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Worlds ``worlds`` were loaded; rows may have moved."""
+        ...
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Advance this stage's part of every world by ``dt`` s."""
+        ...
+
+
+class CrowdStage:
+    """Each world's pedestrian driver, in world order, sees its robots as at the step start."""
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Nothing to do: drivers are reset by :meth:`Engine.reset_worlds`."""
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Step every driver; track the distance walked where the legs gait needs it."""
+        moved = False
+        track = engine.tracks_walked
+        for w, driver in enumerate(engine.drivers):
+            if driver is None:
+                continue
+            before = engine.agents[w].positions
+            agents = driver.step(engine.robots_at_start(w), dt)
+            engine.agents[w] = agents
+            moved = True
+            if track and agents.positions.shape == before.shape:
+                walked = engine.walked[w]
+                if walked.shape[0] != len(agents):  # the crowd changed size: a new gait
+                    walked = np.zeros(len(agents))
+                engine.walked[w] = walked + np.hypot(*(agents.positions - before).T)
+        if moved:
+            engine.gather_agents()
+
+
+class KinematicsStage:
+    """Robots grouped by kinematics model and parameters, one call per group.
+
+    Box models (velocity box and per-axis acceleration limits: diff drive, omni) step their
+    rows in one compiled call built on :func:`~arena.robots.kinematics.base.box_step_row`'s row
+    functions (no steering); the others through :meth:`Kinematics.step` on their gathered rows.
+    """
+
+    def __init__(self) -> None:
+        self._groups: list[tuple[Kinematics, I64, tuple[F64, F64, F64] | None]] = []
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Regroup the rows by model (a task generator hands every episode the same model)."""
+        groups: dict[tuple[str, str], tuple[Kinematics, list[int]]] = {}
+        for row, kin in enumerate(engine.kinematics):
+            key = (kin.name, repr(kin.params))
+            groups.setdefault(key, (kin, []))[1].append(row)
+        self._groups = [
+            (kin, np.array(rows, dtype=np.int64), getattr(kin, "box_limits", None))
+            for kin, rows in groups.values()
+        ]
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Write the unconstrained next poses, twists and steering into the engine."""
+        poses, twists, steer = engine.poses, engine.twists, engine.steering
+        r = poses.shape[0]
+        new_p = np.empty((r, 3))
+        new_t = np.empty((r, 3))
+        new_s = np.empty(r)
+        for kin, rows, box in self._groups:
+            if box is not None:
+                _box_rows(poses, twists, commands, box[0], box[1], box[2], dt, rows, new_p,
+                          new_t, new_s)
+                continue
+            s = kin.step(KinematicState(poses[rows], twists[rows], steer[rows]), commands[rows], dt)
+            new_p[rows], new_t[rows], new_s[rows] = s.poses, s.twists, s.steering
+        engine.next_poses, engine.next_twists, engine.next_steering = new_p, new_t, new_s
+
+
+@njit(cache=True)
+def _box_rows(
+    poses: F64, twists: F64, cmd: F64, lower: F64, upper: F64, acc: F64, dt: float,
+    rows: I64, out_p: F64, out_t: F64, out_s: F64,
+) -> None:
+    """:func:`~arena.robots.kinematics.base.box_step_row` for each row of ``rows``.
+
+    Box models have no steering: ``out_s`` is 0 on those rows.
+    """
+    for k in range(rows.shape[0]):
+        i = rows[k]
+        _box_twist_row(twists, cmd, lower, upper, acc, dt, i, out_t)
+        _integrate_row(poses, out_t, dt, i, out_p)
+        out_s[i] = 0.0
+
+
+class ContactStage:
+    """Exact-footprint contacts at the new poses, walls swept from the previous ones.
+
+    With ``collision_response: stop`` a robot in contact is held at its previous pose with zero
+    twist (its steering unchanged); the contact is reported either way.
+    """
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Nothing to do: the engine tests the contacts of reset worlds itself."""
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Test, respond, and commit the new robot state."""
+        new_p, new_t, new_s = engine.next_poses, engine.next_twists, engine.next_steering
+        old = engine.poses
+        ag_off, ag_pos, ag_r = engine.ag_off, engine.ag_pos, engine.ag_r
+        wall, obstacle, agent, robot = engine.in_pool(
+            engine.num_worlds,
+            lambda parallel: engine.contacts.test(
+                new_p, old, ag_off, ag_pos, ag_r, parallel=parallel
+            ),
+        )
+        # one small compiled test first: contacts are rare, the response's nine arguments
+        # cost more to pass than the test
+        if engine.params.collision_response == "stop" and _any_contact(wall, obstacle, agent,
+                                                                       robot):
+            _hold_blocked(wall, obstacle, agent, robot, old, engine.steering, new_p, new_t, new_s)
+        engine.poses, engine.twists, engine.steering = new_p, new_t, new_s
+        engine.wall, engine.obstacle, engine.agent, engine.robot = wall, obstacle, agent, robot
+        engine.commands = commands.copy()  # the caller may reuse its array
+
+
+@njit(cache=True)
+def _any_contact(wall: NDArray[np.bool_], obstacle: I64, agent: I64, robot: I64) -> bool:
+    """Whether any row touches anything."""
+    for i in range(wall.shape[0]):
+        if wall[i] or obstacle[i] >= 0 or agent[i] >= 0 or robot[i] >= 0:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _hold_blocked(
+    wall: NDArray[np.bool_], obstacle: I64, agent: I64, robot: I64, old_p: F64, old_s: F64,
+    new_p: F64, new_t: F64, new_s: F64,
+) -> None:
+    """``collision_response: stop``: rows in contact keep their pose and steering, at rest.
+
+    One compiled pass instead of half a dozen small array operations per step.
+    """
+    for i in range(wall.shape[0]):
+        if wall[i] or obstacle[i] >= 0 or agent[i] >= 0 or robot[i] >= 0:
+            for k in range(3):
+                new_p[i, k] = old_p[i, k]
+                new_t[i, k] = 0.0
+            new_s[i] = old_s[i]
+
+
+class SensorStage:
+    """Lidar scans of the sensor rows whose period elapsed; the others hold their last scan.
+
+    Noise is added per world from that world's sensor stream: one ``(1, beams)`` normal draw
+    per due scan with ``noise_std > 0``, in sensor-row order (as ``Lidar2D.scan`` draws).
+    """
+
+    def __init__(self) -> None:
+        self._scene = SceneBuilder()
+        self._all_due = np.ones(0, dtype=bool)  # every row due (never written)
+
+    def _due(self, n: int, rows: list[int]) -> NDArray[np.bool_]:
+        """``(n,)`` bool, true on ``rows``."""
+        if len(rows) == n:  # the usual case: every lidar runs at the period of the step
+            if self._all_due.shape[0] != n:
+                self._all_due = np.ones(n, dtype=bool)
+            return self._all_due
+        due = np.zeros(n, dtype=bool)
+        for s in rows:
+            due[s] = True
+        return due
+
+    def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
+        """Nothing to do: the engine scans reset worlds through :meth:`scan`."""
+
+    def step(self, engine: Engine, commands: F64, dt: float) -> None:
+        """Scan the due rows (a 10 Hz lidar in a faster simulation holds its scan)."""
+        if not engine.params.lidar:
+            return
+        times = engine.time
+        last = engine.last_scan
+        period = engine.scan_period
+        rows = [
+            s for s, w in enumerate(engine.sensor_world_list)
+            if not times[w] - last[s] < period[s] - 1e-9
+        ]
+        if rows:
+            self._scan_rows(engine, rows)
+
+    def scan(self, engine: Engine, due: NDArray[np.bool_]) -> None:
+        """Scan the rows of ``due`` ``(S,)`` now (their hold restarts)."""
+        rows = np.flatnonzero(due).tolist()
+        if engine.params.lidar and rows:
+            self._scan_rows(engine, rows)
+
+    def _scan_rows(self, engine: Engine, rows: list[int]) -> None:
+        """Scan sensor rows ``rows`` (ascending), add their noise, restart their hold."""
+        p = engine.params
+        due = self._due(len(engine.specs), rows)
+        agents, walked = engine.agents, engine.walked
+        peds = (
+            [pedestrian_circles(agents[0], walked[0], p)] if len(agents) == 1
+            else [pedestrian_circles(a, walked[w], p) for w, a in enumerate(agents)]
+        )
+        scene = self._scene.build(
+            peds, engine.robot_off, engine.poses, engine.radii, engine.placed_polygons()
+        )
+        poses = engine.poses
+        engine.in_pool(
+            len(rows),
+            lambda parallel: engine.lidars.scan(
+                due, poses, scene, parallel=parallel, chunksize=p.parallel_chunksize
+            ),
+        )
+        scans = list(engine.scans)
+        world_of = engine.sensor_world_list
+        for s in rows:
+            w = world_of[s]
+            engine.last_scan[s] = engine.time[w]
+            # a copy: the bank overwrites its output with the next scan
+            out = engine.lidars.ranges(s).copy()
+            spec = engine.specs[s]
+            if spec.noise_std > 0.0:
+                row = out[None]
+                z = engine.sensor_rng[w].standard_normal(row.shape)
+                _add_noise(row, z, spec.noise_std, spec.range_min, spec.range_max)
+            scans[s] = out
+        engine.scans = scans
+
+
+def check_step(n: int, commands: F64, dt: float) -> F64:
+    """``commands`` as a float64 ``(n, 3)`` array, or :class:`SimulationError`."""
+    cmd = np.asarray(commands, dtype=np.float64)
+    if cmd.shape != (n, 3):
+        raise SimulationError(f"commands must have shape ({n}, 3) [vx, vy, omega], got {cmd.shape}")
+    # math.isfinite over the few values: a fraction of the cost of np.isfinite(...).all()
+    if not all(map(math.isfinite, cmd.ravel().tolist())):
+        raise SimulationError(f"commands must be finite, got {cmd.tolist()}")
+    if not dt > 0:
+        raise SimulationError(f"dt must be > 0 s, got {dt}")
+    if not math.isfinite(dt):
+        raise SimulationError(f"dt must be a finite number > 0, got {dt!r}")
+    return cmd
