@@ -1,7 +1,7 @@
 """RL environment throughput: env steps/s for one SocialNavEnv and the batched vector env.
 
     python benchmarks/env_throughput.py [--steps 10000] [--worlds 16 64] [--threads 2]
-        [--crowds waypoint_walker pysocial]
+        [--crowds fast_social_force pysocial]
 
 The issue-7 setup: a jackal (720 beams, 30 m) among 20 pedestrians on the packaged
 ``small_office`` world with 4 static obstacles; default observation (lidar + goal + last
@@ -16,7 +16,8 @@ resets included (an episode ends on arrival, contact, the 60 s timeout or 500 st
   does; ``--prefetch 0`` draws in-process); the figure is the sum over worlds (N env steps per
   call). ``--crowds`` names the crowds measured: ``none`` (no people), ``pysocial`` (the full
   crowd: social states and groups on, as ``single``), or any other crowd model (social states
-  off).
+  off); the default measures ``fast_social_force`` (the fast crowd training used before the
+  one engine, now a registered crowd model) and ``pysocial``.
 
 Each setup is measured ``--repeat`` times (default 3) and the median printed, with the range:
 on a shared 2-core host the same code varies by a third from one minute to the next.
@@ -114,7 +115,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3,
                     help="measurements per setup; the median is the figure (shared hosts vary)")
     ap.add_argument("--skip-single", action="store_true")
-    ap.add_argument("--crowds", nargs="+", default=["waypoint_walker", "pysocial"],
+    ap.add_argument("--crowds", nargs="+", default=["fast_social_force", "pysocial"],
                     help="batched: crowds measured (none, pysocial = full, or a model name)")
     ap.add_argument("--prefetch", type=int, default=1,
                     help="batched: episodes per world drawn ahead by a helper process "
