@@ -18,6 +18,7 @@ instead of jumping.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -26,6 +27,50 @@ from numpy.typing import NDArray
 from arena.crowd.walls import WallIndex
 
 FloatArray = NDArray[np.float64]
+
+
+WallGuard = tuple[Any, ...]
+"""The kernel's wall-guard arguments, fixed for an episode (:func:`wall_guard`)."""
+
+
+def wall_guard(
+    walls: WallIndex,
+    clearance_map: FloatArray,
+    grid_origin: tuple[float, float],
+    resolution: float,
+) -> WallGuard:
+    """The arguments :func:`integrate_guarded` passes for the walls, gathered once.
+
+    Args:
+        walls: the static segments (indexed).
+        clearance_map: ``(H, W)`` distance (m) from each cell centre to the nearest wall,
+            obstacle or map edge, minus half a cell (:func:`arena.maps.distance.clearance_map`);
+            agents clearly farther from every wall than their step skip the exact test.
+        grid_origin: ``(x, y)`` of the map's lower-left corner (m).
+        resolution: cell size (m).
+
+    Returns:
+        An opaque tuple; a caller that steps one episode keeps it instead of regathering its
+        dozen attributes every step.
+    """
+    cl = walls._cells
+    return (
+        clearance_map,
+        float(grid_origin[0]),
+        float(grid_origin[1]),
+        float(resolution),
+        walls.a,
+        walls.b,
+        cl.points,
+        cl.order,
+        cl.starts,
+        float(cl.origin[0]),
+        float(cl.origin[1]),
+        float(cl.cell),
+        int(cl.shape[0]),
+        int(cl.shape[1]),
+        float(walls.half),
+    )
 
 
 def integrate(
@@ -49,9 +94,7 @@ def integrate(
 
     Args:
         walls: the static segments (indexed).
-        clearance_map: ``(H, W)`` distance (m) from each cell centre to the nearest wall,
-            obstacle or map edge, minus half a cell (:func:`arena.maps.distance.clearance_map`);
-            agents clearly farther from every wall than their step skip the exact test.
+        clearance_map: ``(H, W)`` (see :func:`wall_guard`).
         grid_origin: ``(x, y)`` of the map's lower-left corner (m).
         resolution: cell size (m).
         positions: ``(n, 2)`` m.
@@ -70,7 +113,36 @@ def integrate(
         ``(positions, velocities)`` after the step; the velocity is the displacement over ``dt``
         (so sliding along a wall is what the next step starts from).
     """
-    cl = walls._cells
+    return integrate_guarded(
+        wall_guard(walls, clearance_map, grid_origin, resolution),
+        positions,
+        velocities,
+        update,
+        update_is_velocity,
+        active,
+        vmax,
+        clearance,
+        dt,
+        vmax_factor=vmax_factor,
+        clearance_scale=clearance_scale,
+    )
+
+
+def integrate_guarded(
+    guard: WallGuard,
+    positions: FloatArray,
+    velocities: FloatArray,
+    update: FloatArray,
+    update_is_velocity: bool,
+    active: NDArray[np.bool_],
+    vmax: FloatArray,
+    clearance: FloatArray,
+    dt: float,
+    *,
+    vmax_factor: FloatArray | None = None,
+    clearance_scale: float = 1.0,
+) -> tuple[FloatArray, FloatArray]:
+    """:func:`integrate` with the walls gathered beforehand by :func:`wall_guard`."""
     moved: tuple[FloatArray, FloatArray] = _integrate(
         np.ascontiguousarray(positions, dtype=np.float64),
         np.ascontiguousarray(velocities, dtype=np.float64),
@@ -83,21 +155,7 @@ def integrate(
         np.ascontiguousarray(clearance, dtype=np.float64),
         float(clearance_scale),
         float(dt),
-        clearance_map,
-        float(grid_origin[0]),
-        float(grid_origin[1]),
-        float(resolution),
-        walls.a,
-        walls.b,
-        cl.points,
-        cl.order,
-        cl.starts,
-        float(cl.origin[0]),
-        float(cl.origin[1]),
-        float(cl.cell),
-        int(cl.shape[0]),
-        int(cl.shape[1]),
-        float(walls.half),
+        *guard,
     )
     return moved
 

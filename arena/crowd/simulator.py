@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.base import CrowdFrame, CrowdModel, RobotView
-from arena.crowd.integrator import integrate
+from arena.crowd.integrator import integrate_guarded, wall_guard
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.social import SocialStates
 from arena.crowd.state import CrowdState, StartupMode, leaders_of
@@ -111,6 +111,10 @@ class CrowdSimulator:
         # Distance from each cell to the nearest wall, obstacle or map edge, for the wall
         # guard's fast path (agents far from everything skip the exact segment test).
         self._clearance = crowd_clearance(world.grid, [o.polygon for o in world.obstacles])
+        # The integrator's wall arguments, gathered once per episode.
+        self._guard = wall_guard(
+            self._wall_index, self._clearance, world.grid.origin, world.grid.resolution
+        )
         self._state = state
         self._rows = np.arange(len(state))
         self._members = np.flatnonzero(state.leader != self._rows)
@@ -164,12 +168,8 @@ class CrowdSimulator:
             update = np.asarray(out.accelerations, dtype=np.float64)
             if self.social is not None:
                 update = self.social.post(s, update, dt)
-        grid = self._world.grid
-        s.positions, v = integrate(
-            self._wall_index,
-            self._clearance,
-            grid.origin,
-            grid.resolution,
+        s.positions, v = integrate_guarded(
+            self._guard,
             s.positions,
             s.velocities,
             update,
