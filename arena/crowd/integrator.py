@@ -143,9 +143,13 @@ def integrate_guarded(
     clearance_scale: float = 1.0,
 ) -> tuple[FloatArray, FloatArray]:
     """:func:`integrate` with the walls gathered beforehand by :func:`wall_guard`."""
-    moved: tuple[FloatArray, FloatArray] = _integrate(
-        np.ascontiguousarray(positions, dtype=np.float64),
-        np.ascontiguousarray(velocities, dtype=np.float64),
+    pos = np.ascontiguousarray(positions, dtype=np.float64)
+    vel = np.ascontiguousarray(velocities, dtype=np.float64)
+    # Outputs allocated here: a numba function's returned arrays cost more to box than this.
+    new_p, new_v = np.empty_like(pos), np.empty_like(vel)
+    _integrate(
+        pos,
+        vel,
         np.ascontiguousarray(update, dtype=np.float64),
         update_is_velocity,
         np.ascontiguousarray(active),
@@ -156,8 +160,10 @@ def integrate_guarded(
         float(clearance_scale),
         float(dt),
         *guard,
+        new_p,
+        new_v,
     )
-    return moved
+    return new_p, new_v
 
 
 @njit(cache=True)
@@ -188,11 +194,15 @@ def _integrate(
     nx: int,
     ny: int,
     half: float,
-) -> tuple[FloatArray, FloatArray]:
+    new_p: FloatArray,
+    new_v: FloatArray,
+) -> None:
+    """:func:`integrate_guarded`'s step, written into ``new_p`` and ``new_v``.
+
+    Every row of the ``(n, 2)`` outputs (positions m, velocities m/s) is written.
+    """
     n = pos.shape[0]
     h, w = cmap.shape
-    new_p = np.empty_like(pos)
-    new_v = np.empty_like(vel)
     cand = np.empty(max(wa.shape[0], 1), dtype=np.int64)
     for i in range(n):
         if not active[i]:
@@ -245,7 +255,6 @@ def _integrate(
             qx, qy = x0 + ux * dt, y0 + uy * dt
         new_p[i, 0], new_p[i, 1] = qx, qy
         new_v[i, 0], new_v[i, 1] = ux, uy
-    return new_p, new_v
 
 
 @njit(cache=True, inline="always")

@@ -425,30 +425,36 @@ def robot_view(robots: RobotStates) -> RobotView:
     # NumPy's cos and sin (their SIMD results are what the crowd has always seen); the
     # rotation, and copies of the poses, in one compiled call.
     cos, sin = np.cos(th), np.sin(th)
-    return RobotView(*_robot_frame(robots.poses, robots.twists, robots.radii, cos, sin))
+    # Outputs allocated here: cheaper than boxing arrays a numba function returns.
+    r = th.shape[0]
+    view = RobotView(np.empty((r, 2)), np.empty(r), np.empty((r, 2)), robots.radii.copy())
+    _robot_frame(robots.poses, robots.twists, cos, sin, view.positions, view.headings,
+                 view.velocities)
+    return view
 
 
 @njit(cache=True)
 def _robot_frame(
-    poses: FloatArray, twists: FloatArray, radii: FloatArray, cos: FloatArray, sin: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    poses: FloatArray,
+    twists: FloatArray,
+    cos: FloatArray,
+    sin: FloatArray,
+    pos: FloatArray,
+    heading: FloatArray,
+    vel: FloatArray,
+) -> None:
     """Robot positions, headings and world-frame velocities from poses and body-frame twists.
 
     Args:
         poses: ``(r, 3)`` ``(x, y, θ)`` (m, rad).
         twists: ``(r, ≥ 2)`` body-frame velocities (m/s).
-        radii: ``(r,)`` m.
         cos: ``(r,)`` ``cos θ``.
         sin: ``(r,)`` ``sin θ``.
-
-    Returns:
-        ``(positions (r, 2) m, headings (r,) rad, velocities (r, 2) m/s, radii (r,) m)``, fresh
-        arrays (the :class:`RobotView` fields in order).
+        pos: ``(r, 2)`` out: positions (m).
+        heading: ``(r,)`` out: headings (rad).
+        vel: ``(r, 2)`` out: world-frame velocities (m/s).
     """
     r = poses.shape[0]
-    pos = np.empty((r, 2))
-    heading = np.empty(r)
-    vel = np.empty((r, 2))
     for k in range(r):
         pos[k, 0] = poses[k, 0]
         pos[k, 1] = poses[k, 1]
@@ -457,7 +463,6 @@ def _robot_frame(
         vy = twists[k, 1]
         vel[k, 0] = cos[k] * vx - sin[k] * vy
         vel[k, 1] = sin[k] * vx + cos[k] * vy
-    return pos, heading, vel, radii.copy()
 
 
 @njit(cache=True)
