@@ -127,17 +127,18 @@ class CrowdSimulator:
             self.social = SocialStates()
             self.social.reset(state, world, rng)
         self._update_destinations()
-        return self._snapshot()
+        return self._snapshot(state)
 
     def step(self, robots: RobotStates, dt: float) -> AgentStates:
         """Advance the crowd by ``dt`` seconds, seeing ``robots``."""
         s = self.state
         if len(s) == 0:
             s.time += dt
-            return self._snapshot()
+            return self._snapshot(s)
         view = robot_view(robots)
-        self._start_up(view)
-        self._advance_waypoints()
+        # The helpers take the state from here: one property check per step.
+        self._start_up(s, view)
+        self._advance_waypoints(s)
         if self.social is not None:
             self.social.pre(s, view, self._world, dt)
         active = s.started.copy()
@@ -188,11 +189,10 @@ class CrowdSimulator:
             self.social.orient(s)
         s.forces = out.forces
         s.time += dt
-        return self._snapshot()
+        return self._snapshot(s)
 
     # -- steps ----------------------------------------------------------------------------------
-    def _start_up(self, robots: RobotView) -> None:
-        s = self.state
+    def _start_up(self, s: CrowdState, robots: RobotView) -> None:
         # The common case once every agent has started (count_nonzero: a fraction of the cost
         # of .all() on a few dozen flags).
         if np.count_nonzero(s.started) == s.started.shape[0]:
@@ -208,13 +208,12 @@ class CrowdSimulator:
             trigger[zone] = np.any(d <= s.trigger_radius[zone, None], axis=1)
         s.started = s.started | timer | trigger
 
-    def _advance_waypoints(self) -> None:
+    def _advance_waypoints(self, s: CrowdState) -> None:
         """Tolerant switch, then destinations (see :meth:`_update_destinations`).
 
         Leaders and loners within tolerance of their waypoint take the next. Usually nobody
         arrives, and the destinations computed with the arrival test stand.
         """
-        s = self.state
         arrived, dest = _arrivals(
             s.positions,
             s.waypoints,
@@ -254,8 +253,7 @@ class CrowdSimulator:
         r = ring * spacing
         return np.stack([r * np.cos(angle), r * np.sin(angle)], axis=1)
 
-    def _snapshot(self) -> AgentStates:
-        s = self.state
+    def _snapshot(self, s: CrowdState) -> AgentStates:
         return AgentStates(
             ids=s.ids.copy(),
             positions=s.positions.copy(),
