@@ -159,9 +159,9 @@ def integrate_guarded(
         np.ascontiguousarray(clearance, dtype=np.float64),
         float(clearance_scale),
         float(dt),
-        *guard,
         new_p,
         new_v,
+        *guard,
     )
     return new_p, new_v
 
@@ -179,6 +179,8 @@ def _integrate(
     clearance: FloatArray,
     clearance_scale: float,
     dt: float,
+    new_p: FloatArray,
+    new_v: FloatArray,
     cmap: FloatArray,
     gox: float,
     goy: float,
@@ -194,8 +196,6 @@ def _integrate(
     nx: int,
     ny: int,
     half: float,
-    new_p: FloatArray,
-    new_v: FloatArray,
 ) -> None:
     """:func:`integrate_guarded`'s step, written into ``new_p`` and ``new_v``.
 
