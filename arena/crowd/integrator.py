@@ -18,6 +18,7 @@ instead of jumping.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 from numba import njit
@@ -26,6 +27,50 @@ from numpy.typing import NDArray
 from arena.crowd.walls import WallIndex
 
 FloatArray = NDArray[np.float64]
+
+
+WallGuard = tuple[Any, ...]
+"""The kernel's wall-guard arguments, fixed for an episode (:func:`wall_guard`)."""
+
+
+def wall_guard(
+    walls: WallIndex,
+    clearance_map: FloatArray,
+    grid_origin: tuple[float, float],
+    resolution: float,
+) -> WallGuard:
+    """The arguments :func:`integrate_guarded` passes for the walls, gathered once.
+
+    Args:
+        walls: the static segments (indexed).
+        clearance_map: ``(H, W)`` distance (m) from each cell centre to the nearest wall,
+            obstacle or map edge, minus half a cell (:func:`arena.maps.distance.clearance_map`);
+            agents clearly farther from every wall than their step skip the exact test.
+        grid_origin: ``(x, y)`` of the map's lower-left corner (m).
+        resolution: cell size (m).
+
+    Returns:
+        An opaque tuple; a caller that steps one episode keeps it instead of regathering its
+        dozen attributes every step.
+    """
+    cl = walls._cells
+    return (
+        clearance_map,
+        float(grid_origin[0]),
+        float(grid_origin[1]),
+        float(resolution),
+        walls.a,
+        walls.b,
+        cl.points,
+        cl.order,
+        cl.starts,
+        float(cl.origin[0]),
+        float(cl.origin[1]),
+        float(cl.cell),
+        int(cl.shape[0]),
+        int(cl.shape[1]),
+        float(walls.half),
+    )
 
 
 def integrate(
@@ -49,9 +94,7 @@ def integrate(
 
     Args:
         walls: the static segments (indexed).
-        clearance_map: ``(H, W)`` distance (m) from each cell centre to the nearest wall,
-            obstacle or map edge, minus half a cell (:func:`arena.maps.distance.clearance_map`);
-            agents clearly farther from every wall than their step skip the exact test.
+        clearance_map: ``(H, W)`` (see :func:`wall_guard`).
         grid_origin: ``(x, y)`` of the map's lower-left corner (m).
         resolution: cell size (m).
         positions: ``(n, 2)`` m.
@@ -70,10 +113,43 @@ def integrate(
         ``(positions, velocities)`` after the step; the velocity is the displacement over ``dt``
         (so sliding along a wall is what the next step starts from).
     """
-    cl = walls._cells
-    moved: tuple[FloatArray, FloatArray] = _integrate(
-        np.ascontiguousarray(positions, dtype=np.float64),
-        np.ascontiguousarray(velocities, dtype=np.float64),
+    return integrate_guarded(
+        wall_guard(walls, clearance_map, grid_origin, resolution),
+        positions,
+        velocities,
+        update,
+        update_is_velocity,
+        active,
+        vmax,
+        clearance,
+        dt,
+        vmax_factor=vmax_factor,
+        clearance_scale=clearance_scale,
+    )
+
+
+def integrate_guarded(
+    guard: WallGuard,
+    positions: FloatArray,
+    velocities: FloatArray,
+    update: FloatArray,
+    update_is_velocity: bool,
+    active: NDArray[np.bool_],
+    vmax: FloatArray,
+    clearance: FloatArray,
+    dt: float,
+    *,
+    vmax_factor: FloatArray | None = None,
+    clearance_scale: float = 1.0,
+) -> tuple[FloatArray, FloatArray]:
+    """:func:`integrate` with the walls gathered beforehand by :func:`wall_guard`."""
+    pos = np.ascontiguousarray(positions, dtype=np.float64)
+    vel = np.ascontiguousarray(velocities, dtype=np.float64)
+    # Outputs allocated here: a numba function's returned arrays cost more to box than this.
+    new_p, new_v = np.empty_like(pos), np.empty_like(vel)
+    _integrate(
+        pos,
+        vel,
         np.ascontiguousarray(update, dtype=np.float64),
         update_is_velocity,
         np.ascontiguousarray(active),
@@ -83,23 +159,11 @@ def integrate(
         np.ascontiguousarray(clearance, dtype=np.float64),
         float(clearance_scale),
         float(dt),
-        clearance_map,
-        float(grid_origin[0]),
-        float(grid_origin[1]),
-        float(resolution),
-        walls.a,
-        walls.b,
-        cl.points,
-        cl.order,
-        cl.starts,
-        float(cl.origin[0]),
-        float(cl.origin[1]),
-        float(cl.cell),
-        int(cl.shape[0]),
-        int(cl.shape[1]),
-        float(walls.half),
+        new_p,
+        new_v,
+        *guard,
     )
-    return moved
+    return new_p, new_v
 
 
 @njit(cache=True)
@@ -115,6 +179,8 @@ def _integrate(
     clearance: FloatArray,
     clearance_scale: float,
     dt: float,
+    new_p: FloatArray,
+    new_v: FloatArray,
     cmap: FloatArray,
     gox: float,
     goy: float,
@@ -130,11 +196,13 @@ def _integrate(
     nx: int,
     ny: int,
     half: float,
-) -> tuple[FloatArray, FloatArray]:
+) -> None:
+    """:func:`integrate_guarded`'s step, written into ``new_p`` and ``new_v``.
+
+    Every row of the ``(n, 2)`` outputs (positions m, velocities m/s) is written.
+    """
     n = pos.shape[0]
     h, w = cmap.shape
-    new_p = np.empty_like(pos)
-    new_v = np.empty_like(vel)
     cand = np.empty(max(wa.shape[0], 1), dtype=np.int64)
     for i in range(n):
         if not active[i]:
@@ -187,7 +255,6 @@ def _integrate(
             qx, qy = x0 + ux * dt, y0 + uy * dt
         new_p[i, 0], new_p[i, 1] = qx, qy
         new_v[i, 0], new_v[i, 1] = ux, uy
-    return new_p, new_v
 
 
 @njit(cache=True, inline="always")

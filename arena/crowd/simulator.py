@@ -24,7 +24,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.crowd.base import CrowdFrame, CrowdModel, RobotView
-from arena.crowd.integrator import integrate
+from arena.crowd.integrator import integrate_guarded, wall_guard
 from arena.crowd.neighbors import find_neighbors
 from arena.crowd.social import SocialStates
 from arena.crowd.state import CrowdState, StartupMode, leaders_of
@@ -111,6 +111,10 @@ class CrowdSimulator:
         # Distance from each cell to the nearest wall, obstacle or map edge, for the wall
         # guard's fast path (agents far from everything skip the exact segment test).
         self._clearance = crowd_clearance(world.grid, [o.polygon for o in world.obstacles])
+        # The integrator's wall arguments, gathered once per episode.
+        self._guard = wall_guard(
+            self._wall_index, self._clearance, world.grid.origin, world.grid.resolution
+        )
         self._state = state
         self._rows = np.arange(len(state))
         self._members = np.flatnonzero(state.leader != self._rows)
@@ -123,17 +127,18 @@ class CrowdSimulator:
             self.social = SocialStates()
             self.social.reset(state, world, rng)
         self._update_destinations()
-        return self._snapshot()
+        return self._snapshot(state)
 
     def step(self, robots: RobotStates, dt: float) -> AgentStates:
         """Advance the crowd by ``dt`` seconds, seeing ``robots``."""
         s = self.state
         if len(s) == 0:
             s.time += dt
-            return self._snapshot()
+            return self._snapshot(s)
         view = robot_view(robots)
-        self._start_up(view)
-        self._advance_waypoints()
+        # The helpers take the state from here: one property check per step.
+        self._start_up(s, view)
+        self._advance_waypoints(s)
         if self.social is not None:
             self.social.pre(s, view, self._world, dt)
         active = s.started.copy()
@@ -164,12 +169,8 @@ class CrowdSimulator:
             update = np.asarray(out.accelerations, dtype=np.float64)
             if self.social is not None:
                 update = self.social.post(s, update, dt)
-        grid = self._world.grid
-        s.positions, v = integrate(
-            self._wall_index,
-            self._clearance,
-            grid.origin,
-            grid.resolution,
+        s.positions, v = integrate_guarded(
+            self._guard,
             s.positions,
             s.velocities,
             update,
@@ -188,11 +189,10 @@ class CrowdSimulator:
             self.social.orient(s)
         s.forces = out.forces
         s.time += dt
-        return self._snapshot()
+        return self._snapshot(s)
 
     # -- steps ----------------------------------------------------------------------------------
-    def _start_up(self, robots: RobotView) -> None:
-        s = self.state
+    def _start_up(self, s: CrowdState, robots: RobotView) -> None:
         # The common case once every agent has started (count_nonzero: a fraction of the cost
         # of .all() on a few dozen flags).
         if np.count_nonzero(s.started) == s.started.shape[0]:
@@ -208,13 +208,12 @@ class CrowdSimulator:
             trigger[zone] = np.any(d <= s.trigger_radius[zone, None], axis=1)
         s.started = s.started | timer | trigger
 
-    def _advance_waypoints(self) -> None:
+    def _advance_waypoints(self, s: CrowdState) -> None:
         """Tolerant switch, then destinations (see :meth:`_update_destinations`).
 
         Leaders and loners within tolerance of their waypoint take the next. Usually nobody
         arrives, and the destinations computed with the arrival test stand.
         """
-        s = self.state
         arrived, dest = _arrivals(
             s.positions,
             s.waypoints,
@@ -254,8 +253,7 @@ class CrowdSimulator:
         r = ring * spacing
         return np.stack([r * np.cos(angle), r * np.sin(angle)], axis=1)
 
-    def _snapshot(self) -> AgentStates:
-        s = self.state
+    def _snapshot(self, s: CrowdState) -> AgentStates:
         return AgentStates(
             ids=s.ids.copy(),
             positions=s.positions.copy(),
@@ -425,30 +423,36 @@ def robot_view(robots: RobotStates) -> RobotView:
     # NumPy's cos and sin (their SIMD results are what the crowd has always seen); the
     # rotation, and copies of the poses, in one compiled call.
     cos, sin = np.cos(th), np.sin(th)
-    return RobotView(*_robot_frame(robots.poses, robots.twists, robots.radii, cos, sin))
+    # Outputs allocated here: cheaper than boxing arrays a numba function returns.
+    r = th.shape[0]
+    view = RobotView(np.empty((r, 2)), np.empty(r), np.empty((r, 2)), robots.radii.copy())
+    _robot_frame(robots.poses, robots.twists, cos, sin, view.positions, view.headings,
+                 view.velocities)
+    return view
 
 
 @njit(cache=True)
 def _robot_frame(
-    poses: FloatArray, twists: FloatArray, radii: FloatArray, cos: FloatArray, sin: FloatArray
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    poses: FloatArray,
+    twists: FloatArray,
+    cos: FloatArray,
+    sin: FloatArray,
+    pos: FloatArray,
+    heading: FloatArray,
+    vel: FloatArray,
+) -> None:
     """Robot positions, headings and world-frame velocities from poses and body-frame twists.
 
     Args:
         poses: ``(r, 3)`` ``(x, y, θ)`` (m, rad).
         twists: ``(r, ≥ 2)`` body-frame velocities (m/s).
-        radii: ``(r,)`` m.
         cos: ``(r,)`` ``cos θ``.
         sin: ``(r,)`` ``sin θ``.
-
-    Returns:
-        ``(positions (r, 2) m, headings (r,) rad, velocities (r, 2) m/s, radii (r,) m)``, fresh
-        arrays (the :class:`RobotView` fields in order).
+        pos: ``(r, 2)`` out: positions (m).
+        heading: ``(r,)`` out: headings (rad).
+        vel: ``(r, 2)`` out: world-frame velocities (m/s).
     """
     r = poses.shape[0]
-    pos = np.empty((r, 2))
-    heading = np.empty(r)
-    vel = np.empty((r, 2))
     for k in range(r):
         pos[k, 0] = poses[k, 0]
         pos[k, 1] = poses[k, 1]
@@ -457,7 +461,6 @@ def _robot_frame(
         vy = twists[k, 1]
         vel[k, 0] = cos[k] * vx - sin[k] * vy
         vel[k, 1] = sin[k] * vx + cos[k] * vy
-    return pos, heading, vel, radii.copy()
 
 
 @njit(cache=True)

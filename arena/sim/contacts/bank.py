@@ -258,6 +258,28 @@ class ContactBank:
         do = self._all_rows if rows is None else np.ascontiguousarray(rows, dtype=np.bool_)
         if do.shape != (n,):
             raise SimulationError(f"rows must have shape ({n},), got {do.shape}")
+        return self.test_unchecked(p, prev, previous is not None, off, pos, rad, do, parallel)
+
+    def test_unchecked(
+        self,
+        poses: NDArray[np.float64],
+        previous: NDArray[np.float64],
+        sweep: bool,
+        ag_off: NDArray[np.int64],
+        ag_pos: NDArray[np.float64],
+        ag_r: NDArray[np.float64],
+        rows: NDArray[np.bool_] | None,
+        parallel: bool,
+    ) -> ContactFlags:
+        """:meth:`test` on arguments already in the kernel's form, without checking them.
+
+        For a caller that guarantees them every step (the engine): C-contiguous ``(R, 3)``
+        float64 ``poses`` and ``previous`` (``poses`` itself when not ``sweep``), int64
+        ``ag_off`` of at least ``W + 1`` entries, ``(A, 2)`` and ``(A,)`` float64 pedestrians,
+        ``rows`` ``(R,)`` bool or ``None`` (all). Anything else is undefined: use :meth:`test`.
+        """
+        n = self._row_world.shape[0]
+        do = self._all_rows if rows is None else rows
         wall = np.empty(n, dtype=np.bool_)  # the kernel writes every row
         obstacle = np.empty(n, dtype=np.int64)
         agent = np.empty(n, dtype=np.int64)
@@ -265,9 +287,9 @@ class ContactBank:
         o_off, o_c, o_r, o_vs, o_v = self._packed_obstacles()
         fp_r, fp_reach, fp_vs, fp_v = self._fp
         contacts_rows(parallel)(
-            do, p, prev, previous is not None, self._row_world, self._robot_off,
+            do, poses, previous, sweep, self._row_world, self._robot_off,
             self._g_off, self._g_shape, self._g_par, self._occ, self._dist,
-            o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, off, pos, rad,
+            o_off, o_c, o_r, o_vs, o_v, fp_r, fp_reach, fp_vs, fp_v, ag_off, ag_pos, ag_r,
             wall, obstacle, agent, robot,
         )  # fmt: skip
         return wall, obstacle, agent, robot

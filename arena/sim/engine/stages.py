@@ -140,13 +140,20 @@ class ContactStage:
         """Test, respond, and commit the new robot state."""
         new_p, new_t, new_s = engine.next_poses, engine.next_twists, engine.next_steering
         old = engine.poses
-        ag_off, ag_pos, ag_r = engine.ag_off, engine.ag_pos, engine.ag_r
-        wall, obstacle, agent, robot = engine.in_pool(
-            engine.num_worlds,
-            lambda parallel: engine.contacts.test(
-                new_p, old, ag_off, ag_pos, ag_r, parallel=parallel
-            ),
-        )
+        # The engine's own pose and offset arrays are always C-contiguous float64 / int64 of
+        # the bank's shapes (the kinematics stage builds new_p, this stage commits it): the
+        # unchecked entry. Drivers' pedestrian arrays are normalised (views when they fit).
+        ag_off = engine.ag_off
+        ag_pos = np.ascontiguousarray(engine.ag_pos, dtype=np.float64).reshape(-1, 2)
+        ag_r = np.ascontiguousarray(engine.ag_r, dtype=np.float64).reshape(-1)
+        test = engine.contacts.test_unchecked
+        if engine.parallel(engine.num_worlds):
+            wall, obstacle, agent, robot = engine.in_pool(
+                engine.num_worlds,
+                lambda parallel: test(new_p, old, True, ag_off, ag_pos, ag_r, None, parallel),
+            )
+        else:  # one world (native2d): no pool, no closure
+            wall, obstacle, agent, robot = test(new_p, old, True, ag_off, ag_pos, ag_r, None, False)
         # one small compiled test first: contacts are rare, the response's nine arguments
         # cost more to pass than the test
         if engine.params.collision_response == "stop" and _any_contact(wall, obstacle, agent,

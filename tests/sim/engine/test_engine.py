@@ -105,3 +105,41 @@ def test_bad_calls_raise_simulation_errors() -> None:
         eng.teleport(0, 1, Pose2D(1, 1, 0))
     with pytest.raises(SimulationError, match="num_worlds"):
         Engine(0)
+
+
+class _StridedPeople:
+    """A driver handing out its people as strided (non-contiguous) views: plugins may."""
+
+    def __init__(self, inner) -> None:
+        self.inner = inner
+
+    @staticmethod
+    def _strided(a):
+        wide = np.zeros((len(a), 3))
+        wide[:, :2] = a.positions
+        radii = np.repeat(a.radii, 2)
+        return type(a)(a.ids, wide[:, :2], a.velocities, a.headings, radii[::2], a.kinds,
+                       a.states)
+
+    def reset(self, spawn, world, rng):
+        return self._strided(self.inner.reset(spawn, world, rng))
+
+    def step(self, robots, dt):
+        return self._strided(self.inner.step(robots, dt))
+
+
+def test_contacts_with_pedestrians_handed_out_as_strided_views() -> None:
+    eps = episodes(["jackal"], 1, "task.obstacles.dynamic=12")
+    plain, strided = Engine(1), Engine(1)
+    plain.reset_worlds([0], eps, [driver(WALKER)], [derive_rng(2)])
+    strided.reset_worlds([0], eps, [_StridedPeople(driver(WALKER))], [derive_rng(2)])
+    assert not strided.agents[0].positions.flags.c_contiguous
+    rng = np.random.default_rng(6)
+    touched = 0
+    for k in range(150):
+        cmd = np.array([[rng.uniform(0.5, 2.0), 0.0, rng.uniform(-2.0, 2.0)]])
+        plain.step(cmd, 0.1)
+        strided.step(cmd, 0.1)
+        assert_same_state(plain.world_state(0), strided.world_state(0), f"step {k}")
+        touched += int(plain.agent[0] >= 0)
+    assert touched > 0  # the pedestrian test ran on people in contact
