@@ -440,9 +440,9 @@ def test_round_limits_hold_under_random_commands():
 
 
 @pytest.mark.parametrize("kind", ["diff_drive", "omni"])
-def test_box_step_row_matches_step_bitwise(kind):
+def test_box_step_rows_matches_step_bitwise(kind):
     """The simulator's in-place row stepping gives the bits of ``Kinematics.step``."""
-    from arena.robots.kinematics.base import box_step_row
+    from arena.robots.kinematics.base import box_step_rows
 
     params = dict(SAMPLES[kind])
     params.pop("speed_max", None)  # the box pipeline only: no speed disc
@@ -458,8 +458,8 @@ def test_box_step_row_matches_step_bitwise(kind):
     for dt in (0.01, 0.1, 0.5):
         ref = kin.step(KinematicState(poses, twists, np.zeros(n)), cmd, dt)
         out_p, out_t = np.empty((n, 3)), np.empty((n, 3))
-        for i in range(n):
-            box_step_row(poses, twists, cmd, box, dt, i, out_p, out_t)
+        for i in range(n):  # one row per call, as a simulator with one robot of this model
+            box_step_rows(poses, twists, cmd, *box, dt, np.array([i]), out_p, out_t, np.empty(n))
         assert out_p.tobytes() == ref.poses.tobytes()
         assert out_t.tobytes() == ref.twists.tobytes()
 

@@ -249,53 +249,47 @@ def _box_twist_row(
         out[i, k] = min(max(prev + d, lo), hi)
 
 
-def box_step_row(
+@njit(cache=True)
+def box_step_rows(
     poses: FloatArray,
     twists: FloatArray,
     commands: FloatArray,
-    box: tuple[FloatArray, FloatArray, FloatArray],
+    lower: FloatArray,
+    upper: FloatArray,
+    acc: FloatArray,
     dt: float,
-    i: int,
+    rows: NDArray[np.int64],
     out_poses: FloatArray,
     out_twists: FloatArray,
+    out_steering: FloatArray,
 ) -> None:
-    """:func:`box_step` for row ``i`` only, written into ``out_poses[i]`` and ``out_twists[i]``.
+    """:func:`box_step` for the rows ``rows`` only, written into those rows of the outputs.
 
     For a simulator that keeps the poses ``(r, 3)``, twists ``(r, 3)`` and commands ``(r, 3)``
-    of all its robots in C-contiguous float64 arrays and steps each robot by its own model: no
-    input checks, no intermediate arrays (the caller has validated ``commands`` and ``dt``).
-    The arithmetic is that of :func:`box_step`, so the results are bit-identical.
+    of all its robots in C-contiguous float64 arrays and steps the robots of one box model by
+    one call: no input checks, no intermediate arrays (the caller has validated ``commands``
+    and ``dt``). Each row runs :func:`_box_kernel`'s then :func:`_integrate_kernel`'s row
+    function, the operations of :func:`box_step` in the same order, so the results are
+    bit-identical.
 
     Args:
         poses: ``(r, 3)`` poses ``[x m, y m, theta rad]``.
         twists: ``(r, 3)`` executed twists of the last step ``[vx m/s, vy m/s, omega rad/s]``.
         commands: ``(r, 3)`` desired twists, finite.
-        box: ``(lower, upper, acc)`` each ``(3,)``, a model's :attr:`box_limits`.
+        lower: ``(3,)`` a model's :attr:`box_limits` lower velocity bounds.
+        upper: ``(3,)`` upper velocity bounds.
+        acc: ``(3,)`` acceleration limits.
         dt: step (s), finite and > 0.
-        i: the row to step.
-        out_poses: ``(r, 3)``, row ``i`` receives the new pose.
-        out_twists: ``(r, 3)``, row ``i`` receives the executed twist.
+        rows: the rows to step.
+        out_poses: ``(r, 3)``, each row of ``rows`` receives its new pose.
+        out_twists: ``(r, 3)``, each row receives its executed twist.
+        out_steering: ``(r,)``, each row receives 0 (box models have no steering).
     """
-    _box_row_kernel(poses, twists, commands, box[0], box[1], box[2], float(dt), i, out_poses,
-                    out_twists)
-
-
-@njit(cache=True)
-def _box_row_kernel(
-    poses: FloatArray,
-    twists: FloatArray,
-    cmd: FloatArray,
-    lower: FloatArray,
-    upper: FloatArray,
-    acc: FloatArray,
-    dt: float,
-    i: int,
-    out_p: FloatArray,
-    out_t: FloatArray,
-) -> None:
-    # _box_kernel then _integrate_kernel for one row, the same operations in the same order
-    _box_twist_row(twists, cmd, lower, upper, acc, dt, i, out_t)
-    _integrate_row(poses, out_t, dt, i, out_p)
+    for k in range(rows.shape[0]):
+        i = rows[k]
+        _box_twist_row(twists, commands, lower, upper, acc, dt, i, out_twists)
+        _integrate_row(poses, out_twists, dt, i, out_poses)
+        out_steering[i] = 0.0
 
 
 def quadric_norm(v: FloatArray, weights: FloatArray) -> FloatArray:

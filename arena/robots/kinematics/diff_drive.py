@@ -72,7 +72,7 @@ class DiffDriveKinematics:
         """``(lower, upper, acc)`` ``(3,)`` each over ``[vx, vy, omega]`` (m/s, m/s, rad/s; /s).
 
         :meth:`step` is exactly :func:`~arena.robots.kinematics.base.box_step` with these
-        arrays, so a simulator may call :func:`~arena.robots.kinematics.base.box_step_row`
+        arrays, so a simulator may call :func:`~arena.robots.kinematics.base.box_step_rows`
         instead (not to be modified).
         """
         return self._box

@@ -17,12 +17,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from arena.core.errors import SimulationError
-from arena.robots.kinematics.base import (
-    Kinematics,
-    KinematicState,
-    _box_twist_row,
-    _integrate_row,
-)
+from arena.robots.kinematics.base import Kinematics, KinematicState, box_step_rows
 from arena.sensors.lidar2d.kernels import _add_noise
 from arena.sim.engine.scene import SceneBuilder, pedestrian_circles
 
@@ -75,8 +70,8 @@ class KinematicsStage:
     """Robots grouped by kinematics model and parameters, one call per group.
 
     Box models (velocity box and per-axis acceleration limits: diff drive, omni) step their
-    rows in one compiled call built on :func:`~arena.robots.kinematics.base.box_step_row`'s row
-    functions (no steering); the others through :meth:`Kinematics.step` on their gathered rows.
+    rows in one compiled call built on :func:`~arena.robots.kinematics.base.box_step_rows` (no
+    steering); the others through :meth:`Kinematics.step` on their gathered rows.
     """
 
     def __init__(self) -> None:
@@ -102,28 +97,12 @@ class KinematicsStage:
         new_s = np.empty(r)
         for kin, rows, box in self._groups:
             if box is not None:
-                _box_rows(poses, twists, commands, box[0], box[1], box[2], dt, rows, new_p,
-                          new_t, new_s)
+                box_step_rows(poses, twists, commands, box[0], box[1], box[2], dt, rows, new_p,
+                              new_t, new_s)
                 continue
             s = kin.step(KinematicState(poses[rows], twists[rows], steer[rows]), commands[rows], dt)
             new_p[rows], new_t[rows], new_s[rows] = s.poses, s.twists, s.steering
         engine.next_poses, engine.next_twists, engine.next_steering = new_p, new_t, new_s
-
-
-@njit(cache=True)
-def _box_rows(
-    poses: F64, twists: F64, cmd: F64, lower: F64, upper: F64, acc: F64, dt: float,
-    rows: I64, out_p: F64, out_t: F64, out_s: F64,
-) -> None:
-    """:func:`~arena.robots.kinematics.base.box_step_row` for each row of ``rows``.
-
-    Box models have no steering: ``out_s`` is 0 on those rows.
-    """
-    for k in range(rows.shape[0]):
-        i = rows[k]
-        _box_twist_row(twists, cmd, lower, upper, acc, dt, i, out_t)
-        _integrate_row(poses, out_t, dt, i, out_p)
-        out_s[i] = 0.0
 
 
 class ContactStage:
