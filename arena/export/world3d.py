@@ -67,7 +67,8 @@ def load_export_source(world: str, params: list[str], *, seed: int = 0,
     from arena.core.rng import derive_rng
     from arena.maps.generators import MAP_GENERATORS
     from arena.maps.io import load_map
-    from arena.tasks.scenario import load_scenario, scenario_agents, scenario_obstacles
+    from arena.tasks.scenario import load_scenario
+    from arena.tasks.scenario_convert import scenario_agents, scenario_obstacles
 
     path = Path(world).expanduser()
     is_world = world in packaged_worlds() or path.is_dir()

@@ -13,7 +13,8 @@ from arena.maps.sources import WORLDS_DIR, packaged_worlds, resolve_world
 from arena.robots.presets import load_robot
 from arena.sim.native2d import Native2DBackend
 from arena.tasks.sampling import line_of_sight
-from arena.tasks.scenario import load_scenario, scenario_episode, validate_file
+from arena.tasks.scenario import load_scenario, validate_file
+from arena.tasks.scenario_convert import scenario_episode
 
 WORLDS = ("campus", "corridor", "empty_room", "hospital_floor", "small_office")
 

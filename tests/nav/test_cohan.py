@@ -13,7 +13,7 @@ from arena.core.types import Pose2D
 from arena.experiment import run_experiment
 from arena.nav.local_planners import LOCAL_PLANNERS, LocalObservation
 from arena.nav.local_planners.cohan import CohanPlanner
-from arena.nav.local_planners.teb import BandContext
+from arena.nav.local_planners.teb_band import BandContext
 from arena.robots.kinematics import integrate_twist
 from tests.nav.planner_kit import DIFF, DT, RADIUS
 

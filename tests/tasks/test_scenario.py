@@ -26,10 +26,10 @@ from arena.tasks.scenario import (
     load_scenario,
     parse_scenario,
     save_scenario,
-    scenario_episode,
     validate_file,
 )
 from arena.tasks.scenario_checks import validate_against_map
+from arena.tasks.scenario_convert import scenario_episode
 
 
 def ped(name: str, pos: list[float], waypoints: list[list[float]], **kw: Any) -> dict[str, Any]:

@@ -19,7 +19,8 @@ import pytest
 from arena.core.errors import ConfigError
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
-from arena.tasks.scenario import load_scenario, parse_scenario, scenario_episode
+from arena.tasks.scenario import load_scenario, parse_scenario
+from arena.tasks.scenario_convert import scenario_episode
 
 ROBOT = {"start": [1.0, 1.0, 0.0], "goal": [5.0, 5.0, 0.0]}
 

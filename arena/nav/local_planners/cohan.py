@@ -33,7 +33,8 @@ import numpy as np
 from pydantic import Field
 
 from arena.nav.local_planners.base import LOCAL_PLANNERS
-from arena.nav.local_planners.teb import BandContext, FloatArray, IntArray, TEBPlanner
+from arena.nav.local_planners.teb import TEBPlanner
+from arena.nav.local_planners.teb_band import BandContext, FloatArray, IntArray
 
 
 @LOCAL_PLANNERS.register("cohan", tags=("classic", "optimisation", "social"))

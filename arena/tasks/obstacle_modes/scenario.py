@@ -13,8 +13,8 @@ from arena.scene.episode import AgentSpawn
 from arena.scene.state import Obstacle
 from arena.tasks.base import ResetContext, register_mode
 from arena.tasks.robot_modes.scenario import ScenarioFile, ScenarioRobots
-from arena.tasks.scenario import scenario_agents, scenario_obstacles
 from arena.tasks.scenario_checks import check_robot_bodies
+from arena.tasks.scenario_convert import scenario_agents, scenario_obstacles
 
 
 @register_mode("obstacles", "scenario", tags=("file",))

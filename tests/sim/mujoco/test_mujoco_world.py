@@ -164,7 +164,8 @@ def test_episode_world_from_a_scenario() -> None:
     from arena.maps.io import load_map
     from arena.maps.sources import resolve_scenario, resolve_world
     from arena.sim.mujoco.world import build_episode_world
-    from arena.tasks.scenario import load_scenario, scenario_episode
+    from arena.tasks.scenario import load_scenario
+    from arena.tasks.scenario_convert import scenario_episode
 
     scenario = load_scenario(resolve_scenario("small_office/default"))
     episode = scenario_episode(scenario, load_map(resolve_world("small_office")),
