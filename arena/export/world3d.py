@@ -9,8 +9,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+import arena.plugins  # noqa: F401  (registers the map generators)
+from arena.config.loader import parse_override
 from arena.core.errors import ConfigError
 from arena.core.files import make_dir, read_json
+from arena.core.rng import derive_rng
+from arena.maps.generators import MAP_GENERATORS
+from arena.maps.io import load_map
 from arena.maps.obstacles import make_obstacle
 from arena.maps.sources import MapResult, packaged_worlds, resolve_scenario, world_folder
 from arena.scene.episode import AgentSpawn
@@ -19,6 +24,8 @@ from arena.sim.mujoco.mjcf import to_mjcf
 from arena.sim.mujoco.scene import Scene3D, WorldParams
 from arena.sim.mujoco.sdf import to_sdf
 from arena.sim.mujoco.world import build_world
+from arena.tasks.scenario import load_scenario
+from arena.tasks.scenario_convert import scenario_agents, scenario_obstacles
 
 Format = Literal["sdf", "mjcf"]
 FILE_NAMES: dict[str, str] = {"sdf": "world.sdf", "mjcf": "world.xml"}
@@ -62,14 +69,6 @@ def load_export_source(world: str, params: list[str], *, seed: int = 0,
     Raises:
         ConfigError: an unknown world or generator, bad parameters, or a bad scenario.
     """
-    import arena.plugins  # noqa: F401  (registers the map generators)
-    from arena.config.loader import parse_override
-    from arena.core.rng import derive_rng
-    from arena.maps.generators import MAP_GENERATORS
-    from arena.maps.io import load_map
-    from arena.tasks.scenario import load_scenario
-    from arena.tasks.scenario_convert import scenario_agents, scenario_obstacles
-
     path = Path(world).expanduser()
     is_world = world in packaged_worlds() or path.is_dir()
     if (is_world or path.suffix in (".yaml", ".yml")) and params:
