@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -15,11 +16,15 @@ class LidarSpec(BaseModel):
     Beam ``i`` points at ``angle_min + i · angle_increment`` in the sensor frame. A scan covering
     the full circle (``angle_max - angle_min`` ≥ 2π − 1e-3) spreads ``num_beams`` beams evenly
     without repeating the first beam; otherwise the first and last beams sit at ``angle_min`` and
-    ``angle_max``.
+    ``angle_max``. The ``Params`` of the ``lidar2d`` sensor type
+    (:data:`arena.sensors.base.SENSORS`).
     """
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
+    type: Literal["lidar2d"] = Field(
+        "lidar2d", description="sensor type (registry name); optional in Arena's laser block"
+    )
     angle_min: float = Field(description="rad, first beam angle in the sensor frame")
     angle_max: float = Field(description="rad, last beam angle in the sensor frame")
     num_beams: int = Field(

@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import SimulationError
 from arena.maps.grid import OccupancyGrid
+from arena.sensors.base import SENSORS
 from arena.sensors.lidar2d.bank_kernels import (
     BAD_POSE,
     BAD_SCENE,
@@ -169,14 +170,17 @@ class _MapSlot:
 _EMPTY_OWNER = np.zeros(0, dtype=np.int64)
 
 
+@SENSORS.register("lidar2d")
 class LidarBank:
-    """Every lidar of every world, scanned in one kernel call.
+    """Every lidar of every world, scanned in one kernel call: the ``lidar2d`` sensor bank.
 
     Usage: ``bank = LidarBank()``; when world ``w`` resets, ``bank.bind_world(w, grid, a, b)``;
     after any reset ``bank.set_sensors(row_world, row_robot, specs)``; per step
     ``bank.scan(due, poses, scene)`` and read ``bank.ranges(s)``. One caller at a time: the
     work arrays are per pool thread, not per caller.
     """
+
+    Params = LidarSpec
 
     def __init__(self) -> None:
         self._dist = _Blocks(((), np.float32))
@@ -405,6 +409,10 @@ class LidarBank:
         when the row layout changes: copy it to keep it.
         """
         return self._out[self._out_off[s] : self._out_off[s + 1]]
+
+    def reading(self, s: int) -> F64:
+        """:meth:`ranges` (the :class:`~arena.sensors.base.SensorBank` reading)."""
+        return self.ranges(s)
 
     def scan(
         self, due: ArrayLike, poses: ArrayLike, scene: DynamicGeometry, *,
