@@ -287,6 +287,42 @@ class RobotModel(BaseModel):
             return "laser"
         return lidars[0] if lidars else None
 
+    def model_copy(
+        self, *, update: Mapping[str, Any] | None = None, deep: bool = False
+    ) -> RobotModel:
+        """A copy with fields replaced; ``update={"laser": spec}`` replaces the primary lidar.
+
+        Like ``model_copy`` everywhere, ``update`` is not validated (the ``laser`` spec must
+        be a :class:`LidarSpec`).
+        """
+        if update is not None and "laser" in update:
+            rest = dict(update)
+            laser = rest.pop("laser")
+            if not isinstance(laser, LidarSpec):
+                raise TypeError(f"laser must be a LidarSpec, got {type(laser).__name__}")
+            sensors = dict(rest.get("sensors", self.sensors))
+            sensors[self.primary_lidar or "laser"] = laser
+            rest["sensors"] = sensors
+            update = rest
+        return super().model_copy(update=update, deep=deep)
+
+    def lidar(self, name: str, *, path: str | None = None) -> LidarSpec:
+        """The ``lidar2d`` sensor ``name``.
+
+        Raises:
+            ConfigError: at ``path`` (the option that named it), when the robot carries no
+                ``lidar2d`` of that name; the message lists its lidars.
+        """
+        spec = self.sensors.get(name)
+        if not isinstance(spec, LidarSpec):
+            lidars = [k for k, v in self.sensors.items() if isinstance(v, LidarSpec)]
+            raise ConfigError(
+                f"robot {self.name!r} has no lidar2d sensor {name!r} "
+                f"(its lidar2d sensors: {', '.join(lidars) or 'none'})",
+                path=path,
+            )
+        return spec
+
     @property
     def laser(self) -> LidarSpec:
         """The primary 2-D lidar's spec (:attr:`primary_lidar`), for Arena files and old code.

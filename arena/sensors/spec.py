@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -67,3 +68,23 @@ class LidarSpec(BaseModel):
     def angles(self) -> NDArray[np.float64]:
         """Beam angles in the sensor frame, shape ``(num_beams,)`` (rad)."""
         return self.angle_min + self.angle_increment * np.arange(self.num_beams, dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class LidarReading:
+    """One lidar's latest scan with its geometry, as a local planner reads it.
+
+    Attributes:
+        ranges: ``(beams,)`` m.
+        angles: ``(beams,)`` beam angles in the robot frame, mount yaw included (rad).
+        origin: ``(2,)`` sensor position in the robot frame (m).
+    """
+
+    ranges: NDArray[np.float64]
+    angles: NDArray[np.float64]
+    origin: NDArray[np.float64]
+
+
+def lidar_geometry(spec: LidarSpec) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(angles (beams,) rad, origin (2,) m)`` of ``spec``'s beams in the robot frame."""
+    return spec.angles() + spec.mount[2], np.array(spec.mount[:2], dtype=np.float64)
