@@ -45,7 +45,8 @@ def build_stack(
     The goal tolerances follow the episode: position within ``0.9 · goal_radius`` (or the
     navigation config's, if smaller) and, when the task checks the heading
     (``goal_tolerance_angle``), the heading too. The stack reads the lidar
-    ``cfg.scan_sensor``; its ranges at the sensor's ``range_max`` count as free space. ``local_planner`` replaces the configured one (a trainer's planner).
+    ``cfg.scan_sensor``; its ranges at the sensor's ``range_max`` count as free space.
+    ``local_planner`` replaces the configured one (a trainer's planner).
     """
     yaw = cfg.goal_tolerance_yaw
     if episode.goal_tolerance_angle is not None:
@@ -54,7 +55,9 @@ def build_stack(
         cfg, robot_radius=robot.radius,
         footprint_radius=robot.inscribed_radius or None,  # narrow passages: the body fits
         local_planner=local_planner,
-        scan_range_max=float(robot.lidar(cfg.scan_sensor, path="navigation.scan_sensor").range_max),
+        scan_range_max=float(
+            robot.lidar(cfg.scan_sensor, path="navigation.scan_sensor").range_max
+        ),
         goal_tolerance=(min(cfg.goal_tolerance_xy, 0.9 * episode.goal_radius), yaw),
     )
 

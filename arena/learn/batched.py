@@ -543,7 +543,8 @@ class _Frame:
     """The engine's state as the env reads it; arrays the engine never writes into.
 
     ``time`` ``(N,)`` s; ``poses``/``twists`` ``(N, 3)``; ``scans`` ``(N, B)`` m (each
-    world's ``observation.sensor`` lidar); ``ped_*`` ``(N, P, ...)`` padded, valid where ``ped_mask``.
+    world's ``observation.sensor`` lidar); ``ped_*`` ``(N, P, ...)`` padded, valid where
+    ``ped_mask``.
     """
 
     time: F64

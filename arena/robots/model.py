@@ -27,7 +27,7 @@ from pydantic import (
     model_validator,
 )
 
-from arena.core.errors import ConfigError
+from arena.core.errors import ConfigError, UnknownNameError
 from arena.core.geometry import (
     bounding_radius,
     convex_hull,
@@ -63,7 +63,10 @@ def _sensor_params(name: str, block: Any, path: str) -> BaseModel:
                 path=path,
             )
         return block
-    params = SENSORS.check(block, path=path)
+    try:
+        params = SENSORS.check(block, path=path)
+    except UnknownNameError as e:  # a bad field of this robot, not an unknown robot
+        raise ConfigError(e.message, path=e.path) from None
     kind = block["type"] if isinstance(block, Mapping) else block
     if params is None or getattr(params, "type", None) != kind:
         raise ConfigError(
