@@ -535,6 +535,10 @@ class Engine:
     ) -> tuple[tuple[F64, ...], tuple[Mapping[str, F64], ...]]:
         """World ``w``'s per-robot primary lidar scans and sensors by name from its rows."""
         per_robot = self._robot_sensors[w]
+        if len(per_robot) == 1 and len(per_robot[0].rows) == 1:  # the usual case, kept cheap
+            rs = per_robot[0]
+            r = readings[0]
+            return (r if rs.primary == 0 else _NO_READING,), (MappingProxyType({rs.rows[0][0]: r}),)
         scans = tuple(readings[rs.primary] if rs.primary >= 0 else _NO_READING
                       for rs in per_robot)
         sensors = tuple(MappingProxyType({name: readings[k] for name, k in rs.rows})
@@ -559,7 +563,13 @@ class Engine:
         if not self._ready[w]:
             raise SimulationError("the backend has not been reset with an episode yet")
         s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
-        readings = [_frozen_copy(r) for r in self.scans[s0:s1]]
+        readings = self.scans[s0:s1]
+        if len(readings) == 1:
+            c = readings[0].copy()
+            c.flags.writeable = False
+            readings = [c]
+        else:
+            readings = [_frozen_copy(r) for r in readings]
         scans, sensors = self._readings(w, readings)
         if self.num_worlds == 1:
             # Every row is world 0's. The commands and contact flags are arrays of this step
