@@ -18,8 +18,7 @@ in by registering, without touching the engine::
         def bind_world(self, w, grid, segments_a, segments_b): ...
         def set_sensors(self, row_world, row_robot, specs): ...
         def scan(self, due, poses, scene, *, parallel=False, chunksize=1): ...
-        def reading(self, s): ...
-        def add_noise(self, s, rng): ...
+        def read(self, s, rng): ...
 """
 
 from __future__ import annotations
@@ -45,8 +44,8 @@ class SensorBank(Protocol):
     Usage by the engine: ``bind_world`` when world ``w`` resets; ``set_sensors`` after any
     reset (row ``s`` carried by global robot row ``row_robot[s]`` of world ``row_world[s]``,
     parameters ``specs[s]``); per step ``scan(due, poses, scene)`` on the due rows, then per
-    due row, in row order, ``add_noise(s, rng)`` with that world's sensor stream and
-    ``reading(s)`` (copied by the engine).
+    due row, in row order, ``read(s, rng)`` with that world's sensor stream (the engine keeps
+    the array it returns: a new one each time).
     """
 
     Params: ClassVar[type[BaseModel]]
@@ -74,12 +73,11 @@ class SensorBank(Protocol):
         """
         ...
 
-    def reading(self, s: int) -> NDArray[np.float64]:
-        """Row ``s``'s latest reading (may be a view the bank overwrites later)."""
-        ...
+    def read(self, s: int, rng: np.random.Generator | None) -> NDArray[np.float64]:
+        """Row ``s``'s latest reading as a new array, its noise drawn from ``rng``.
 
-    def add_noise(self, s: int, rng: np.random.Generator) -> None:
-        """Add row ``s``'s noise to its latest reading, drawn from ``rng`` (nothing if none)."""
+        ``rng`` ``None``: without noise (the reading of a row before its first scan).
+        """
         ...
 
 

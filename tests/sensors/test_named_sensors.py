@@ -199,11 +199,9 @@ class RangeRingBank:
             xy, r = scene.circ_xy[a:b][peds], scene.circ_r[a:b][peds]
             self.out[s] = ring(xy, r, x, y, th, spec)
 
-    def reading(self, s: int) -> np.ndarray:
-        return self.out[s]
-
-    def add_noise(self, s: int, rng: np.random.Generator) -> None:
-        """No noise."""
+    def read(self, s: int, rng: np.random.Generator | None) -> np.ndarray:
+        """A copy of the latest reading (no noise)."""
+        return self.out[s].copy()
 
 
 def ring(xy, r, x, y, th, spec: RangeRingSpec) -> np.ndarray:

@@ -8,7 +8,7 @@ static geometry plus its :class:`DynamicGeometry` (pedestrians, robot bodies). E
 same per-sensor function as :meth:`Lidar2D.scan_many <arena.sensors.lidar2d.Lidar2D.scan_many>`
 (:func:`~arena.sensors.lidar2d.kernels._scan_one`), so a row's ranges are bit-identical to a
 :class:`~arena.sensors.lidar2d.Lidar2D` scan of the same scene; see :mod:`.model` for what a
-beam hits. The bank draws no noise: :meth:`LidarBank.add_noise` applies a row's noise from the
+beam hits. The bank draws no noise: :meth:`LidarBank.read` applies a row's noise from the
 caller's generator.
 
 Static tables are packed in flat buffers (layout: :mod:`.bank_kernels`). A grid is converted
@@ -410,10 +410,6 @@ class LidarBank:
         """
         return self._out[self._out_off[s] : self._out_off[s + 1]]
 
-    def reading(self, s: int) -> F64:
-        """:meth:`ranges` (the :class:`~arena.sensors.base.SensorBank` reading)."""
-        return self.ranges(s)
-
     def scan(
         self, due: ArrayLike, poses: ArrayLike, scene: DynamicGeometry, *,
         parallel: bool = False, chunksize: int = 1,
@@ -475,6 +471,17 @@ class LidarBank:
         if code == BAD_POSE:
             raise SimulationError("LidarBank: the poses of the scanning robots must be finite")
 
+    def read(self, s: int, rng: np.random.Generator | None) -> F64:
+        """Row ``s``'s latest ranges with their noise drawn from ``rng``: a new array.
+
+        The :class:`~arena.sensors.base.SensorBank` reading: the bank's own ranges stay as
+        scanned; the noise is :meth:`add_noise`'s (none when ``rng`` is ``None``).
+        """
+        out = self.ranges(s).copy()  # the bank overwrites its own with the next scan
+        if rng is not None and self._row_specs[s].noise_std > 0.0:  # the usual: no call
+            self._noise(s, out, rng)
+        return out
+
     def add_noise(self, s: int, rng: np.random.Generator) -> None:
         """Add row ``s``'s range noise, drawn from ``rng``, to its latest ranges.
 
@@ -482,9 +489,12 @@ class LidarBank:
         :meth:`Lidar2D.scan <arena.sensors.lidar2d.Lidar2D.scan>` draws per scan), nothing
         otherwise; max-range returns stay, the rest is clipped to the range limits.
         """
+        self._noise(s, self.ranges(s), rng)
+
+    def _noise(self, s: int, ranges: F64, rng: np.random.Generator) -> None:
+        """Row ``s``'s noise added to ``ranges`` ``(num_beams,)`` in place."""
         spec = self._row_specs[s]
         if spec.noise_std > 0.0:
-            out = self.ranges(s)[None]
-            _add_noise(out, rng.standard_normal(out.shape), spec.noise_std, spec.range_min,
+            row = ranges[None]
+            _add_noise(row, rng.standard_normal(row.shape), spec.noise_std, spec.range_min,
                        spec.range_max)
-

@@ -42,6 +42,7 @@ from arena.robots.kinematics.base import Kinematics
 from arena.robots.model import RobotModel
 from arena.scene.episode import Episode
 from arena.scene.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
+from arena.sensors.base import SensorBank
 from arena.sim.backend import PedestrianDriver, split_rng
 from arena.sim.contacts import ContactBank, Footprint
 from arena.sim.engine.params import EngineParams
@@ -176,6 +177,7 @@ class Engine:
         self.sensor_name: list[str] = []
         self.sensor_kind: list[str] = []  # registry name of the row's type (its bank)
         self.sensor_local: list[int] = []  # the row's index in its bank
+        self.sensor_bank: list[SensorBank] = []  # the row's bank
         self._robot_sensors: list[tuple[_RobotSensors, ...]] = [()] * w_n
         self.specs: list[BaseModel] = []
         self.scan_period: list[float] = []
@@ -369,11 +371,12 @@ class Engine:
         self.scan_period = [1.0 / float(s.update_rate) for s in s_specs]  # type: ignore[attr-defined]
         self.last_scan = s_last
         self.contacts.set_robots(self.row_world, fps)
-        self.sensor_local = self.sensor_stage.set_rows(self, s_kinds, s_world, s_robot, s_specs)
-        banks = self.sensor_stage.banks
+        self.sensor_local, self.sensor_bank = self.sensor_stage.set_rows(
+            self, s_kinds, s_world, s_robot, s_specs
+        )
         for s, reading in enumerate(s_scans):
             if reading is _NO_READING:  # a fresh row: what its bank reads before a scan
-                s_scans[s] = banks[s_kinds[s]].reading(self.sensor_local[s]).copy()
+                s_scans[s] = _frozen(self.sensor_bank[s].read(self.sensor_local[s], None))
         self.scans = s_scans
 
     def _footprint(self, polygon: F64 | None, radius: float) -> Footprint:
@@ -563,13 +566,8 @@ class Engine:
         if not self._ready[w]:
             raise SimulationError("the backend has not been reset with an episode yet")
         s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
+        # the readings are read-only arrays the engine replaces, never writes: shared
         readings = self.scans[s0:s1]
-        if len(readings) == 1:
-            c = readings[0].copy()
-            c.flags.writeable = False
-            readings = [c]
-        else:
-            readings = [_frozen_copy(r) for r in readings]
         scans, sensors = self._readings(w, readings)
         if self.num_worlds == 1:
             # Every row is world 0's. The commands and contact flags are arrays of this step
@@ -629,11 +627,10 @@ class Engine:
         return self._padded
 
 
-def _frozen_copy(a: F64) -> F64:
-    """A read-only copy of ``a`` (the snapshot's readings are shared by its keys)."""
-    c = a.copy()
-    c.flags.writeable = False
-    return c
+def _frozen(a: F64) -> F64:
+    """``a`` made read-only (readings are shared by snapshots and their keys)."""
+    a.flags.writeable = False
+    return a
 
 
 def _no_flags(n: int) -> tuple[B1, I64, I64, I64]:

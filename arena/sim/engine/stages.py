@@ -10,6 +10,7 @@ out, so a caller may keep them).
 from __future__ import annotations
 
 import math
+from functools import partial
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
@@ -221,8 +222,8 @@ class SensorStage:
     def set_rows(
         self, engine: Engine, kinds: list[str], worlds: list[int], robots: list[int],
         specs: list[BaseModel],
-    ) -> list[int]:
-        """Hand each bank its rows; returns each sensor row's index within its bank."""
+    ) -> tuple[list[int], list[SensorBank]]:
+        """Hand each bank its rows; returns each sensor row's index within its bank and bank."""
         local: list[int] = []
         per: dict[str, tuple[list[int], list[int], list[BaseModel]]] = {k: ([], [], []) for k in
                                                                       self.banks}
@@ -238,7 +239,7 @@ class SensorStage:
         for kind, (ws, rs, ss) in per.items():
             self.banks[kind].set_sensors(ws, rs, ss)
             self._bank_rows[kind] = len(ws)
-        return local
+        return local, [self.banks[k] for k in kinds]
 
     def _due(self, n: int, rows: list[int]) -> NDArray[np.bool_]:
         """``(n,)`` bool, true on ``rows``."""
@@ -287,41 +288,36 @@ class SensorStage:
             peds, engine.robot_off, engine.poses, engine.radii, engine.placed_polygons()
         )
         poses = engine.poses
-        kind_of, local = engine.sensor_kind, engine.sensor_local
-        if len(self.banks) == 1:
-            (kind, bank), = self.banks.items()
-            mine = [local[s] for s in rows]
-            self._scan_bank(engine, bank, len(mine), self._due(self._bank_rows[kind], mine),
-                            poses, scene)
-        else:
-            for kind, bank in self.banks.items():
+        chunk = p.parallel_chunksize
+        local = engine.sensor_local
+        for kind, bank in self.banks.items():
+            if len(self.banks) == 1:  # one type: its rows are the sensor rows, in order
+                mine = rows
+            else:
+                kind_of = engine.sensor_kind
                 mine = [local[s] for s in rows if kind_of[s] == kind]
-                if mine:
-                    self._scan_bank(engine, bank, len(mine), self._due(self._bank_rows[kind],
-                                                                       mine), poses, scene)
+                if not mine:
+                    continue
+            due = self._due(self._bank_rows[kind], mine)
+            engine.in_pool(len(mine), partial(_scan, bank, due, poses, scene, chunk))
         scans = list(engine.scans)
-        world_of = engine.sensor_world_list
-        banks = self.banks
+        world_of, row_bank, rngs = engine.sensor_world_list, engine.sensor_bank, engine.sensor_rng
+        times, last = engine.time, engine.last_scan
         for s in rows:
             w = world_of[s]
-            engine.last_scan[s] = engine.time[w]
-            bank = banks[kind_of[s]]
-            k = local[s]
-            bank.add_noise(k, engine.sensor_rng[w])
-            scans[s] = bank.reading(k).copy()  # a copy: the bank overwrites it with the next
+            last[s] = times[w]
+            reading = row_bank[s].read(local[s], rngs[w])
+            reading.flags.writeable = False  # shared by the snapshots: never written
+            scans[s] = reading
         engine.scans = scans
 
-    @staticmethod
-    def _scan_bank(
-        engine: Engine, bank: SensorBank, n: int, due: NDArray[np.bool_], poses: F64,
-        scene: DynamicScene,
-    ) -> None:
-        """``bank.scan`` of its ``n`` rows in ``due``, on the pool if worth it."""
-        chunk = engine.params.parallel_chunksize
-        engine.in_pool(
-            n,
-            lambda parallel: bank.scan(due, poses, scene, parallel=parallel, chunksize=chunk),
-        )
+
+def _scan(
+    bank: SensorBank, due: NDArray[np.bool_], poses: F64, scene: DynamicScene, chunk: int,
+    parallel: bool,
+) -> None:
+    """``bank.scan`` of its ``due`` rows (for :meth:`Engine.in_pool`)."""
+    bank.scan(due, poses, scene, parallel=parallel, chunksize=chunk)
 
 
 def check_step(n: int, commands: F64, dt: float) -> F64:
