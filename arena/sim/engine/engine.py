@@ -45,6 +45,7 @@ from arena.scene.state import AgentStates, Collisions, RobotStates, SimState, St
 from arena.sensors.base import SensorBank
 from arena.sim.backend import PedestrianDriver, split_rng
 from arena.sim.contacts import ContactBank, Footprint
+from arena.sim.engine.agents import PaddedAgents, pad_agents, standing_agents
 from arena.sim.engine.params import EngineParams
 from arena.sim.engine.stages import (
     ContactStage,
@@ -59,29 +60,6 @@ F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 B1 = NDArray[np.bool_]
 T = TypeVar("T")
-
-
-@dataclass(frozen=True, eq=False)
-class PaddedAgents:
-    """The pedestrians of all worlds padded to ``P`` slots: ``(W, P, ...)`` arrays.
-
-    Attributes:
-        positions: ``(W, P, 2)`` m (padding 0).
-        velocities: ``(W, P, 2)`` m/s (padding 0).
-        headings: ``(W, P)`` rad (padding 0).
-        radii: ``(W, P)`` m (padding 0).
-        kinds: ``(W, P)`` type codes (padding -1).
-        states: ``(W, P)`` social-state codes (padding -1).
-        mask: ``(W, P)`` bool, the slot holds a pedestrian.
-    """
-
-    positions: F64
-    velocities: F64
-    headings: F64
-    radii: F64
-    kinds: I64
-    states: I64
-    mask: B1
 
 
 _NO_READING = np.zeros(0)
@@ -252,7 +230,7 @@ class Engine:
         self.drivers[w] = driver
         self.agents[w] = (
             driver.reset(ep.agents, world, crowd_rng) if driver is not None
-            else _standing_agents(ep)
+            else standing_agents(ep)
         )
         self.walked[w] = np.zeros(len(self.agents[w]))
         self.time[w] = 0.0
@@ -600,32 +578,9 @@ class Engine:
 
     def padded_agents(self) -> PaddedAgents:
         """Every world's pedestrians padded to the largest crowd (built once per step)."""
-        if self._padded is not None:
-            return self._padded
-        w_n = self.num_worlds
-        counts = np.diff(self.ag_off)
-        p = int(counts.max()) if w_n else 0
-        world = np.repeat(np.arange(w_n), counts)
-        slot = np.arange(int(self.ag_off[-1])) - self.ag_off[world]
-        ags = self.agents
-        pos = np.zeros((w_n, p, 2))
-        vel = np.zeros((w_n, p, 2))
-        head = np.zeros((w_n, p))
-        rad = np.zeros((w_n, p))
-        kinds = np.full((w_n, p), -1, dtype=np.int64)
-        states = np.full((w_n, p), -1, dtype=np.int64)
-        mask = np.zeros((w_n, p), dtype=bool)
-        if world.size:
-            pos[world, slot] = self.ag_pos
-            rad[world, slot] = self.ag_r
-            vel[world, slot] = np.concatenate([a.velocities for a in ags])
-            head[world, slot] = np.concatenate([a.headings for a in ags])
-            kinds[world, slot] = np.concatenate([a.kinds for a in ags])
-            states[world, slot] = np.concatenate([a.states for a in ags])
-            mask[world, slot] = True
-        self._padded = PaddedAgents(pos, vel, head, rad, kinds, states, mask)
+        if self._padded is None:
+            self._padded = pad_agents(self.agents, self.ag_off, self.ag_pos, self.ag_r)
         return self._padded
-
 
 def _frozen(a: F64) -> F64:
     """``a`` made read-only (readings are shared by snapshots and their keys)."""
@@ -636,18 +591,3 @@ def _frozen(a: F64) -> F64:
 def _no_flags(n: int) -> tuple[B1, I64, I64, I64]:
     neg = np.full(n, -1, dtype=np.int64)
     return np.zeros(n, dtype=bool), neg, neg.copy(), neg.copy()
-
-
-def _standing_agents(episode: Episode) -> AgentStates:
-    """The episode's pedestrians standing at their spawn (no driver)."""
-    sp = episode.agents
-    n = len(sp)
-    return AgentStates(
-        ids=np.arange(n, dtype=np.int64),
-        positions=sp.positions.astype(np.float64, copy=True),
-        velocities=np.zeros((n, 2)),
-        headings=np.zeros(n),
-        radii=sp.radii.astype(np.float64, copy=True),
-        kinds=sp.kinds.astype(np.int64, copy=True),
-        states=np.zeros(n, dtype=np.int64),
-    )
