@@ -10,6 +10,7 @@ structure of the input, so this file needs no timeouts: a regression would hang 
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 
@@ -24,6 +25,20 @@ BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
 """The "billion laughs" YAML: 10 lines that expand to 9**10 (3.5 billion) strings."""
 
 BURGER = (Path(cli.__file__).parent / "robots" / "presets" / "burger.yaml").read_text()
+# the burger with its laser written as named sensors, and a second lidar block to add to it
+BURGER_SENSORS = re.sub(
+    r"^laser:\n((?:  .*\n)+)",
+    lambda m: "sensors:\n  laser:\n    type: lidar2d\n" + m.group(1).replace("  ", "    "),
+    BURGER, count=1, flags=re.MULTILINE,
+)
+
+
+def with_rear(block: str) -> str:
+    """The burger in the sensors layout with ``block`` added under ``sensors``."""
+    return BURGER_SENSORS.replace("  laser:\n", block + "  laser:\n", 1)
+
+
+REAR = "  rear: {type: lidar2d, angle_min: -0.5, angle_max: 0.5, num_beams: 9, range_max: 5}\n"
 
 SCENARIO = {
     "robots": [{"start": [2.0, 2.0, 0.0], "goal": [8.0, 8.0, 0.0]}],
@@ -121,6 +136,10 @@ FILES: dict[str, str | bytes] = {
     "robot_unknown.yaml": BURGER + "wheels: 4\n",
     "robot_beams.yaml": BURGER.replace("num_beams: 360", "num_beams: 1000000000"),
     "robot_range.yaml": BURGER.replace("range_max: 3.5", "range_max: .inf"),
+    "robot_sensor_type.yaml": BURGER_SENSORS.replace("type: lidar2d", "type: lidar3d"),
+    "robot_sensor_field.yaml": with_rear(REAR.replace("num_beams", "num_beam")),
+    "robot_sensor_both.yaml": BURGER + "sensors: {}\n",
+    "robot_sensor_name.yaml": with_rear(REAR.replace("  rear:", "  rear-left:")),
     # maps (map.pgm is written by the fixture)
     "map_origin.yaml": MAP_YAML.replace("[0.0, 0.0, 0.0]", "[1.0e20, 0.0, 0.0]"),
     "map_dup.yaml": MAP_YAML + "resolution: 0.1\n",
@@ -366,6 +385,16 @@ CASES: list[tuple[str, list[str], list[str]]] = [
      ["robot_beams.yaml", "laser.num_beams", "10000"]),
     ("robot_range", ["run", "robot={d}/robot_range.yaml"],
      ["robot_range.yaml", "laser.range_max", "1000"]),
+    ("robot_sensor_type", ["run", "robot={d}/robot_sensor_type.yaml"],
+     ["robot_sensor_type.yaml", "sensors.laser.type", "lidar3d", "lidar2d"]),
+    ("robot_sensor_both", ["run", "robot={d}/robot_sensor_both.yaml"],
+     ["robot_sensor_both.yaml", "laser", "not both"]),
+    ("robot_sensor_misspelt", ["run", "robot={d}/robot_sensor_field.yaml"],
+     ["robot_sensor_field.yaml", "sensors.rear.num_beam"]),
+    ("robot_sensor_name", ["run", "robot={d}/robot_sensor_name.yaml"],
+     ["robot_sensor_name.yaml", "sensors.rear-left", "identifier"]),
+    ("scan_sensor_unknown", ["run", "navigation.scan_sensor=rear", Q],
+     ["navigation.scan_sensor", "no lidar2d sensor 'rear'", "laser"]),
     # -- maps
     ("map_origin", ["run", "--map", "{d}/map_origin.yaml"], ["map_origin.yaml", "origin", "1e+06"]),
     ("map_dup", ["run", "--map", "{d}/map_dup.yaml"], ["map_dup.yaml", "duplicate key"]),

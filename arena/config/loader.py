@@ -232,6 +232,10 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
         robot = load_robot(cfg.robot)
     except UnknownNameError as e:
         raise UnknownNameError(e.message, source=source, path="robot") from None
+    try:
+        robot.lidar(cfg.navigation.scan_sensor, path="navigation.scan_sensor")
+    except ConfigError as e:
+        raise e.located(source=source) from None
     kind = robot.kinematics_type
     supported = getattr(local.obj, "supports", frozenset())
     if kind not in supported:

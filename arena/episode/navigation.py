@@ -21,6 +21,7 @@ from arena.maps.raster import planning_grid
 from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack, NavStatus
+from arena.sensors.spec import LidarReading, LidarSpec, lidar_geometry
 
 if TYPE_CHECKING:
     from arena.nav.local_planners.base import LocalPlanner
@@ -43,8 +44,9 @@ def build_stack(
 
     The goal tolerances follow the episode: position within ``0.9 · goal_radius`` (or the
     navigation config's, if smaller) and, when the task checks the heading
-    (``goal_tolerance_angle``), the heading too. Laser ranges at the sensor's ``range_max``
-    count as free space. ``local_planner`` replaces the configured one (a trainer's planner).
+    (``goal_tolerance_angle``), the heading too. The stack reads the lidar
+    ``cfg.scan_sensor``; its ranges at the sensor's ``range_max`` count as free space.
+    ``local_planner`` replaces the configured one (a trainer's planner).
     """
     yaw = cfg.goal_tolerance_yaw
     if episode.goal_tolerance_angle is not None:
@@ -53,7 +55,9 @@ def build_stack(
         cfg, robot_radius=robot.radius,
         footprint_radius=robot.inscribed_radius or None,  # narrow passages: the body fits
         local_planner=local_planner,
-        scan_range_max=float(robot.laser.range_max),
+        scan_range_max=float(
+            robot.lidar(cfg.scan_sensor, path="navigation.scan_sensor").range_max
+        ),
         goal_tolerance=(min(cfg.goal_tolerance_xy, 0.9 * episode.goal_radius), yaw),
     )
 
@@ -75,6 +79,8 @@ class NavigationController(EpisodeHooks):
         stack: robot 0's navigation stack (:func:`build_stack`).
         runtime: the task's runtime (when goals are reached and what comes next).
         robot: robot 0's model.
+        scan_sensor: the lidar whose scan is the observation's ``scan_*`` fields
+            (``navigation.scan_sensor``); every sensor is in its ``sensors`` by name.
 
     Attributes:
         goal: robot 0's current goal.
@@ -82,14 +88,21 @@ class NavigationController(EpisodeHooks):
         teleported: robot 0's recorded rows reached by a teleport (not driven).
     """
 
-    def __init__(self, stack: NavigationStack, runtime: TaskRuntime, robot: RobotModel) -> None:
+    def __init__(
+        self, stack: NavigationStack, runtime: TaskRuntime, robot: RobotModel,
+        scan_sensor: str = "laser",
+    ) -> None:
         self.stack = stack
         self.runtime = runtime
         self.robot = robot
         self.limits = robot.limits()
-        laser = robot.laser
-        self.angles = laser.angles() + laser.mount[2]
-        self.scan_origin = np.array(laser.mount[:2])
+        robot.lidar(scan_sensor, path="navigation.scan_sensor")  # a clear error, not a KeyError
+        self.scan_sensor = scan_sensor
+        # beam geometry per lidar, computed once (the readings change, the mounts do not)
+        self._geometry = {
+            name: lidar_geometry(spec) for name, spec in robot.sensors.items()
+            if isinstance(spec, LidarSpec)
+        }
         self.goal: Pose2D | None = None
         self.control_s: list[float] = []
 
@@ -136,6 +149,14 @@ class NavigationController(EpisodeHooks):
         assert state is not None
         assert self.goal is not None
         robot = self.robot
+        sensors: dict[str, LidarReading | FloatArray] = {}
+        for name, reading in state.robots.sensors[0].items():
+            geometry = self._geometry.get(name)
+            sensors[name] = (
+                LidarReading(reading, *geometry) if geometry is not None else reading
+            )
+        scan = sensors[self.scan_sensor]
+        assert isinstance(scan, LidarReading)
         obs = LocalObservation(
             pose=state.robots.poses[0],
             twist=state.robots.twists[0],
@@ -144,9 +165,10 @@ class NavigationController(EpisodeHooks):
             limits=self.limits,
             robot_radius=robot.radius,
             dt=runner.dt,
-            scan_ranges=state.robots.scans[0],
-            scan_angles=self.angles,
-            scan_origin=self.scan_origin,
+            scan_ranges=scan.ranges,
+            scan_angles=scan.angles,
+            scan_origin=scan.origin,
+            sensors=sensors,
             time=state.time,
             kinematics=robot.kinematics_type,
         )

@@ -135,7 +135,9 @@ def run_episode(
     robot = spawn.model
     seed, idx = cfg.seed, episode.index
     dt = cfg.sim.dt
-    nav = NavigationController(build_stack(cfg.navigation, robot, episode), runtime, robot)
+    nav = NavigationController(
+        build_stack(cfg.navigation, robot, episode), runtime, robot, cfg.navigation.scan_sensor
+    )
     recorder = Recorder()
     contacts = _ContactCounter()
     frames = _Frames(nav) if video else None

@@ -73,7 +73,9 @@ class Recorder(EpisodeHooks):
 
     Args:
         keep_scans: also keep robot 0's laser scan of every row (``scans``: ``(T, beams)`` m),
-            e.g. for :func:`arena.eval.io.export_arena_csv`'s ``scan.csv``.
+            e.g. for :func:`arena.eval.io.export_arena_csv`'s ``scan.csv``. It is robot 0's
+            primary lidar (``RobotStates.scans``: the sensor named ``laser``); to record another
+            sensor, read ``state.robots.sensors[0][name]`` in an ``after_step`` hook.
         capacity: initial number of robot rows reserved.
     """
 

@@ -167,6 +167,8 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         self._time_limit = np.zeros(n)
         self._steps = np.zeros(n, dtype=np.int64)
         self._scans = np.zeros((n, stack, self.obs_builder.beams))
+        self._sensor = self.env_cfg.observation.sensor  # the lidar the observation reads
+        self._scan_rows: list[int] = []  # per world its sensor row (rows move on resets)
         self._last_action = np.zeros((n, 3))
         self._autoreset = np.zeros(n, dtype=bool)
         self._outcome: NDArray[np.object_] = np.full(n, None, dtype=object)
@@ -255,19 +257,30 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
                 )
         drivers = [build_driver(self.cfg.crowd, self.cfg.pedestrians) for _ in eps]
         self.sim.reset_worlds(worlds, eps, drivers, rngs)
+        self._scan_rows = self.sim.sensor_rows(self._sensor).tolist()
         return self._frame()
 
     def _frame(self) -> _Frame:
-        """What the env reads of the engine now (one robot and one laser per world)."""
+        """What the env reads of the engine now (one robot per world, its observed lidar)."""
         sim = self.sim
         peds = sim.padded_agents()
-        first = sim.sensor_off[:-1].tolist()
         return _Frame(
             time=np.array(sim.time), poses=sim.poses, twists=sim.twists,
-            scans=np.stack([sim.scans[s] for s in first]),
+            scans=np.stack([sim.scans[s] for s in self._scan_rows]),
             ped_positions=peds.positions, ped_velocities=peds.velocities,
             ped_kinds=peds.kinds, ped_states=peds.states, ped_mask=peds.mask,
         )
+
+    def sensor_readings(self, name: str) -> F64:
+        """``(N, ...)`` each world's robot's latest reading of its sensor ``name``.
+
+        A lidar's is ``(N, beams)`` m. Raises ``KeyError`` when the robot has no such sensor.
+        """
+        rows = self.sim.sensor_rows(name).tolist()
+        if not rows or min(rows) < 0:
+            raise KeyError(f"the robot has no sensor {name!r} (its sensors: "
+                           f"{', '.join(self.robot.sensors)})")
+        return np.stack([self.sim.scans[s] for s in rows])
 
     def _request_next(self, worlds: Sequence[int] | NDArray[np.int64]) -> None:
         """Ask the prefetcher for the next ``prefetch`` episodes of each world in ``worlds``."""
@@ -530,7 +543,8 @@ class _Frame:
     """The engine's state as the env reads it; arrays the engine never writes into.
 
     ``time`` ``(N,)`` s; ``poses``/``twists`` ``(N, 3)``; ``scans`` ``(N, B)`` m (each
-    world's laser); ``ped_*`` ``(N, P, ...)`` padded, valid where ``ped_mask``.
+    world's ``observation.sensor`` lidar); ``ped_*`` ``(N, P, ...)`` padded, valid where
+    ``ped_mask``.
     """
 
     time: F64

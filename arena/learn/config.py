@@ -99,6 +99,10 @@ class ObservationConfig(_Strict):
         False, description="'velocity': [vx, vy, ω] measured body twist (vy = 0 for diff drive)"
     )
     laser_stack: int = Field(1, ge=1, description="number of most recent scans stacked")
+    sensor: str = Field(
+        "laser", pattern=r"^[A-Za-z_][A-Za-z0-9_]*$",
+        description="the robot's lidar2d sensor the 'lidar' part reads",
+    )
     goal_max_distance: float = Field(
         30.0, gt=0, description="m; ρ is clipped to this (Arena's GOAL space: [0, 30])"
     )

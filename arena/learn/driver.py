@@ -104,6 +104,8 @@ class EpisodeDriver:
         self.substeps = substeps(self.env_cfg, self.dt)
         self.period = self.dt * self.substeps
         self.obs_builder = ObservationBuilder(self.env_cfg.observation, self.robot)
+        self._sensor = self.env_cfg.observation.sensor  # the lidar the observation reads
+        self._sensor_is_primary = self.robot.primary_lidar == self._sensor
         self.decoder = ActionDecoder(self.env_cfg.action, self.robot)
         self.reward_fn = RewardFunction(self.env_cfg.reward)
         self.backend: SimulatorBackend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
@@ -174,7 +176,7 @@ class EpisodeDriver:
         self.active[:] = True
         # a new array, not written in place: after a step self.scans may be a view of a snapshot
         self.scans = np.repeat(
-            np.stack(self.state.robots.scans)[:, None, :], self.scans.shape[1], axis=1
+            np.stack(self._robot_scans())[:, None, :], self.scans.shape[1], axis=1
         )
         self._renderer: Any = None  # drawn lazily, once per episode (the world changes)
         # per-episode constants of the reward input (allocated once, never written to)
@@ -290,7 +292,7 @@ class EpisodeDriver:
             collision_a = self._advance(cmd)
             collision = collision_a.item()
         # _push_scans with one view instead of three: scan (beams,), stacked (1, 1, beams)
-        scan = self.state.robots.scans[0]
+        scan = self._robot_scans()[0]
         stacked = scan[None, None]
         if self.scans.shape[1] == 1:
             self.scans = stacked
@@ -387,10 +389,18 @@ class EpisodeDriver:
         self.robot_steps += 1
         return collision
 
+    def _robot_scans(self) -> tuple[FloatArray, ...]:
+        """Per robot the ranges of the observed lidar (``observation.sensor``)."""
+        assert self.state is not None
+        robots = self.state.robots
+        if self._sensor_is_primary:  # RobotStates.scans is that lidar's: no lookups
+            return robots.scans
+        return tuple(m[self._sensor] for m in robots.sensors)
+
     def _push_scans(self) -> FloatArray:
         """Append the new scans to the laser stack; return them ``(r, beams)``."""
         assert self.state is not None
-        robot_scans = self.state.robots.scans
+        robot_scans = self._robot_scans()
         # The snapshot's scans are copies the backend never writes to; views of them serve
         # (reset replaces self.scans instead of writing into it).
         scans = robot_scans[0][None] if self.n_robots == 1 else np.stack(robot_scans)
@@ -535,7 +545,7 @@ class EpisodeDriver:
         self.last_action = self.last_action.copy()
         self.last_action[i] = 0.0
         self.scans = self.scans.copy()
-        self.scans[i] = self.state.robots.scans[i][None, :]
+        self.scans[i] = self._robot_scans()[i][None, :]
         self.robot_steps[i] = 0
         self.active[i] = True
         if self.subgoals is not None:
@@ -573,7 +583,7 @@ class EpisodeDriver:
         if getattr(self, "_renderer", None) is None:
             self._renderer = FrameRenderer(
                 self.backend.world,
-                lidar_specs=[self.robot.laser] * self.n_robots,
+                lidar_specs=[self.robot.laser] * self.n_robots,  # draws RobotStates.scans
                 width_px=width_px or self.cfg.output.width_px,
                 show_trails=False,
             )

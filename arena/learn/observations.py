@@ -166,8 +166,11 @@ class ObservationBuilder:
 
     def __init__(self, config: ObservationConfig, robot: RobotModel) -> None:
         self.config = config
-        self.beams = int(robot.laser.num_beams)
-        self.range_max = float(robot.laser.range_max)
+        self.lidar_spec = robot.lidar(
+            config.sensor, path="learning.env.observation.sensor"
+        )
+        self.beams = int(self.lidar_spec.num_beams)
+        self.range_max = float(self.lidar_spec.range_max)
         lim = robot.limits()
         parts: dict[str, spaces.Box] = {}
         if config.lidar:

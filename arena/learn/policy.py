@@ -316,7 +316,7 @@ def random_policy(
         "action": action,
         "command": command,
         "observation": env_config.observation.model_dump(mode="json"),
-        "laser": laser_meta(robot.laser),
+        "laser": laser_meta(robot.lidar(env_config.observation.sensor)),
         "random": True,
     }
     arrays["meta"] = np.array(json.dumps(meta))

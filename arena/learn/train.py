@@ -281,7 +281,7 @@ def train(
                 model, venv if nc.norm_obs else None, path,
                 decoder=ActionDecoder(cfg.learning.env.action, rob),
                 observation=cfg.learning.env.observation.model_dump(mode="json"),
-                laser=rob.laser,
+                laser=rob.lidar(cfg.learning.env.observation.sensor),
             )
 
         def checkpoint() -> None:
@@ -392,7 +392,8 @@ def export_checkpoint(checkpoint: str | Path, out: str | Path | None = None) -> 
     return export_policy(
         model, vecnorm, Path(out) if out is not None else ckpt / "policy.npz",
         decoder=ActionDecoder(cfg.learning.env.action, rob),
-        observation=cfg.learning.env.observation.model_dump(mode="json"), laser=rob.laser,
+        observation=cfg.learning.env.observation.model_dump(mode="json"),
+        laser=rob.lidar(cfg.learning.env.observation.sensor),
     )
 
 

@@ -222,6 +222,10 @@ class NavigationConfig(BaseModel):
         default_factory=lambda: {"type": "bypass"},
         description="intermediate planner block {type: name, **params}",
     )
+    scan_sensor: str = Field(
+        "laser", pattern=r"^[A-Za-z_][A-Za-z0-9_]*$",
+        description="the robot's lidar2d sensor the stack and its costmaps read",
+    )
     intermediate_period: float = Field(
         0.0, ge=0, description="s between intermediate-planner calls; 0 = every control tick"
     )

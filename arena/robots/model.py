@@ -1,13 +1,18 @@
-"""A robot as validated data: kinematics, footprint, laser and action space.
+"""A robot as validated data: kinematics, footprint, named sensors and action space.
 
 The layout mirrors Arena-Rosnav's ``model_params.yaml`` (radius, actions, laser) plus the flatland
 footprint and a kinematics block validated through :data:`~arena.robots.kinematics.KINEMATICS`.
+Sensors are a mapping of names to ``{type: <sensor type>, **params}`` blocks validated through
+:data:`~arena.sensors.base.SENSORS`; Arena's single ``laser:`` block is read as
+``sensors: {laser: {type: lidar2d, ...}}``.
 Presets live in ``arena/robots/presets/*.yaml`` and load with
 :func:`arena.robots.presets.load_robot`.
 """
 
 from __future__ import annotations
 
+import re
+from collections.abc import Mapping
 from functools import cached_property
 from typing import Annotated, Any, Literal
 
@@ -22,7 +27,7 @@ from pydantic import (
     model_validator,
 )
 
-from arena.core.errors import ConfigError
+from arena.core.errors import ConfigError, UnknownNameError
 from arena.core.geometry import (
     bounding_radius,
     convex_hull,
@@ -32,6 +37,7 @@ from arena.core.geometry import (
 )
 from arena.robots.kinematics import KINEMATICS, Kinematics
 from arena.robots.limits import VelocityLimits
+from arena.sensors.base import SENSORS
 from arena.sensors.spec import LidarSpec
 
 _TOL = 1e-9  # slack for comparing configured numbers with derived limits
@@ -41,6 +47,39 @@ def _ordered_pair(v: tuple[float, float]) -> tuple[float, float]:
     if not v[0] <= v[1]:
         raise ValueError(f"expected [min, max] with min <= max, got {list(v)}")
     return v
+
+
+_SENSOR_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")  # keys, columns and file names
+
+
+def _sensor_params(name: str, block: Any, path: str) -> BaseModel:
+    """One sensor block (a mapping or already validated params) as its validated params."""
+    if isinstance(block, BaseModel):  # built in code: params of a registered type
+        kind = getattr(block, "type", None)
+        if not isinstance(kind, str) or kind not in SENSORS:
+            raise ConfigError(
+                f"{type(block).__name__} is not the params of a registered sensor type "
+                f"(one of: {', '.join(SENSORS.names())})",
+                path=path,
+            )
+        return block
+    try:
+        params = SENSORS.check(block, path=path)
+    except UnknownNameError as e:  # a bad field of this robot, not an unknown robot
+        raise ConfigError(e.message, path=e.path) from None
+    kind = block["type"] if isinstance(block, Mapping) else block
+    if params is None or getattr(params, "type", None) != kind:
+        raise ConfigError(
+            f"sensor type {kind!r}: its Params must declare a field "
+            f"type: Literal[{kind!r}] = {kind!r}",
+            path=path,
+        )
+    rate = getattr(params, "update_rate", None)
+    if not isinstance(rate, int | float) or not rate > 0:
+        raise ConfigError(
+            f"sensor type {kind!r}: its Params must declare update_rate (Hz, > 0)", path=path
+        )
+    return params
 
 
 Range = Annotated[tuple[float, float], AfterValidator(_ordered_pair)]
@@ -150,7 +189,10 @@ class RobotModel(BaseModel):
         footprint: collision shape in the body frame (m).
         height: body height above the floor (m) for 3-D worlds; ``None`` where unknown (such a
             robot cannot be placed in a 3-D world).
-        laser: the 2-D laser scanner.
+        sensors: the robot's sensors by name (insertion-ordered), each the validated
+            ``Params`` of its registered type (:data:`~arena.sensors.base.SENSORS`). Names are
+            identifiers. Arena's ``laser:`` block is read as ``sensors: {laser: ...}``.
+        laser: (read-only) the primary 2-D lidar, see :attr:`primary_lidar`.
         actions: discrete and continuous action spaces for learning agents.
         sources: where the numbers come from (free text, one citation per entry).
     """
@@ -164,9 +206,57 @@ class RobotModel(BaseModel):
     radius: float = Field(gt=0, description="m, Arena's robot_radius (inflation, safety)")
     footprint: Footprint
     height: float | None = Field(None, gt=0, le=5, description="m, body height (3-D worlds)")
-    laser: LidarSpec
+    sensors: dict[str, Any] = Field(
+        description="{name: {type: <sensor type>, **params}}; Arena's `laser:` block is `laser`"
+    )
     actions: Actions
     sources: tuple[str, ...] = Field((), description="citations for the numbers")
+
+    @model_validator(mode="before")
+    @classmethod
+    def _laser_block(cls, data: Any) -> Any:
+        # Arena's model_params.yaml layout: one `laser:` block, the sensor named `laser`
+        if not isinstance(data, Mapping) or "laser" not in data:
+            if isinstance(data, Mapping) and "sensors" not in data:
+                raise ConfigError(
+                    "required key is missing: give the robot a `laser` block (Arena's layout) "
+                    "or a `sensors` mapping",
+                    path="laser",
+                )
+            return data
+        if "sensors" in data:
+            raise ConfigError(
+                "give either `laser` (Arena's layout) or `sensors`, not both "
+                "(`laser: {...}` is `sensors: {laser: {type: lidar2d, ...}}`)",
+                path="laser",
+            )
+        out = dict(data)
+        laser = out.pop("laser")
+        if isinstance(laser, Mapping):
+            laser = {"type": "lidar2d", **laser}
+        elif not isinstance(laser, LidarSpec):
+            raise ConfigError(f"expected a mapping of lidar fields, got {laser!r}", path="laser")
+        out["sensors"] = {"laser": _sensor_params("laser", laser, "laser")}
+        return out
+
+    @field_validator("sensors", mode="before")
+    @classmethod
+    def _validate_sensors(cls, v: Any) -> dict[str, BaseModel]:
+        if not isinstance(v, Mapping):
+            raise ConfigError(
+                f"expected a mapping of sensor names to {{type: ..., ...}} blocks, got {v!r}",
+                path="sensors",
+            )
+        out: dict[str, BaseModel] = {}
+        for name, block in v.items():
+            if not isinstance(name, str) or not _SENSOR_NAME.match(name):
+                raise ConfigError(
+                    f"sensor name {name!r} must be an identifier (letters, digits and _, not "
+                    "starting with a digit): it names state keys, columns and files",
+                    path=f"sensors.{name}",
+                )
+            out[name] = _sensor_params(name, block, f"sensors.{name}")
+        return out
 
     @field_validator("kinematics", mode="before")
     @classmethod
@@ -187,6 +277,68 @@ class RobotModel(BaseModel):
         return self
 
     # -- derived ---------------------------------------------------------------------------
+    @property
+    def primary_lidar(self) -> str | None:
+        """Name of the primary 2-D lidar: ``laser`` if it is a ``lidar2d``, else the first one.
+
+        ``None`` when the robot carries no ``lidar2d``. :attr:`laser`,
+        :attr:`arena.scene.state.RobotStates.scans` and the scan fields of a local observation
+        are this sensor's.
+        """
+        lidars = [k for k, v in self.sensors.items() if isinstance(v, LidarSpec)]
+        if "laser" in lidars:
+            return "laser"
+        return lidars[0] if lidars else None
+
+    def model_copy(
+        self, *, update: Mapping[str, Any] | None = None, deep: bool = False
+    ) -> RobotModel:
+        """A copy with fields replaced; ``update={"laser": spec}`` replaces the primary lidar.
+
+        Like ``model_copy`` everywhere, ``update`` is not validated (the ``laser`` spec must
+        be a :class:`LidarSpec`).
+        """
+        if update is not None and "laser" in update:
+            rest = dict(update)
+            laser = rest.pop("laser")
+            if not isinstance(laser, LidarSpec):
+                raise TypeError(f"laser must be a LidarSpec, got {type(laser).__name__}")
+            sensors = dict(rest.get("sensors", self.sensors))
+            sensors[self.primary_lidar or "laser"] = laser
+            rest["sensors"] = sensors
+            update = rest
+        return super().model_copy(update=update, deep=deep)
+
+    def lidar(self, name: str, *, path: str | None = None) -> LidarSpec:
+        """The ``lidar2d`` sensor ``name``.
+
+        Raises:
+            ConfigError: at ``path`` (the option that named it), when the robot carries no
+                ``lidar2d`` of that name; the message lists its lidars.
+        """
+        spec = self.sensors.get(name)
+        if not isinstance(spec, LidarSpec):
+            lidars = [k for k, v in self.sensors.items() if isinstance(v, LidarSpec)]
+            raise ConfigError(
+                f"robot {self.name!r} has no lidar2d sensor {name!r} "
+                f"(its lidar2d sensors: {', '.join(lidars) or 'none'})",
+                path=path,
+            )
+        return spec
+
+    @property
+    def laser(self) -> LidarSpec:
+        """The primary 2-D lidar's spec (:attr:`primary_lidar`), for Arena files and old code.
+
+        Raises:
+            ConfigError: the robot carries no ``lidar2d`` sensor.
+        """
+        name = self.primary_lidar
+        if name is None:
+            raise ConfigError(f"robot {self.name!r} carries no lidar2d sensor", path="sensors")
+        spec: LidarSpec = self.sensors[name]
+        return spec
+
     @property
     def kinematics_type(self) -> str:
         """The kinematics registry name (``diff_drive``, ``omni``, ``ackermann``, ``legged``)."""

@@ -6,7 +6,9 @@ that the backend never mutates afterwards, so a recorder may keep them.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -87,7 +89,12 @@ class RobotStates:
         commands: ``(r, 3)`` commands received on the last step (before limits).
         radii: ``(r,)`` circumscribed radius of each footprint (m).
         footprints: per robot ``(k, 2)`` body-frame polygon, or ``None`` for a circular robot.
-        scans: per robot ``(beams,)`` lidar ranges (m) taken at the end of the step.
+        scans: per robot ``(beams,)`` ranges (m) of its primary lidar
+            (:attr:`arena.robots.model.RobotModel.primary_lidar`, the sensor ``laser`` of every
+            preset) taken at the end of the step; ``(0,)`` for a robot without a lidar.
+        sensors: per robot its sensors' latest readings by name (read-only mapping; the engine
+            gives read-only arrays), e.g. ``sensors[0]["rear"]`` ``(beams,)`` m for a lidar.
+            Left empty by a caller, it becomes ``{"laser": scans[i]}`` per robot.
     """
 
     names: tuple[str, ...]
@@ -98,6 +105,12 @@ class RobotStates:
     radii: FloatArray
     footprints: tuple[FloatArray | None, ...]
     scans: tuple[FloatArray, ...]
+    sensors: tuple[Mapping[str, FloatArray], ...] = ()
+
+    def __post_init__(self) -> None:
+        if not self.sensors and self.scans:  # built by hand with scans only: Arena's laser
+            by_name = tuple(MappingProxyType({"laser": s}) for s in self.scans)
+            object.__setattr__(self, "sensors", by_name)
 
     def __len__(self) -> int:
         return len(self.names)

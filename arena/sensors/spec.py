@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -15,11 +17,15 @@ class LidarSpec(BaseModel):
     Beam ``i`` points at ``angle_min + i · angle_increment`` in the sensor frame. A scan covering
     the full circle (``angle_max - angle_min`` ≥ 2π − 1e-3) spreads ``num_beams`` beams evenly
     without repeating the first beam; otherwise the first and last beams sit at ``angle_min`` and
-    ``angle_max``.
+    ``angle_max``. The ``Params`` of the ``lidar2d`` sensor type
+    (:data:`arena.sensors.base.SENSORS`).
     """
 
     model_config = ConfigDict(frozen=True, extra="forbid")
 
+    type: Literal["lidar2d"] = Field(
+        "lidar2d", description="sensor type (registry name); optional in Arena's laser block"
+    )
     angle_min: float = Field(description="rad, first beam angle in the sensor frame")
     angle_max: float = Field(description="rad, last beam angle in the sensor frame")
     num_beams: int = Field(
@@ -62,3 +68,23 @@ class LidarSpec(BaseModel):
     def angles(self) -> NDArray[np.float64]:
         """Beam angles in the sensor frame, shape ``(num_beams,)`` (rad)."""
         return self.angle_min + self.angle_increment * np.arange(self.num_beams, dtype=np.float64)
+
+
+@dataclass(frozen=True, eq=False)
+class LidarReading:
+    """One lidar's latest scan with its geometry, as a local planner reads it.
+
+    Attributes:
+        ranges: ``(beams,)`` m.
+        angles: ``(beams,)`` beam angles in the robot frame, mount yaw included (rad).
+        origin: ``(2,)`` sensor position in the robot frame (m).
+    """
+
+    ranges: NDArray[np.float64]
+    angles: NDArray[np.float64]
+    origin: NDArray[np.float64]
+
+
+def lidar_geometry(spec: LidarSpec) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``(angles (beams,) rad, origin (2,) m)`` of ``spec``'s beams in the robot frame."""
+    return spec.angles() + spec.mount[2], np.array(spec.mount[:2], dtype=np.float64)

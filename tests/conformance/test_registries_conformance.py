@@ -29,6 +29,7 @@ COVERED = {
     "map generator": "here",
     "metric": "tests/conformance/test_metrics_conformance.py",
     "reward term": "tests/learn/test_rewards.py",
+    "sensor": "tests/sensors/test_named_sensors.py",
 }
 
 

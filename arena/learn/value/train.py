@@ -326,7 +326,9 @@ def run_training_episode(cfg: ExperimentConfig, generator: TaskGenerator,
     robot = episode.robots[0].model
     planner.logs = logs = [EpisodeLog() for _ in planner.horizons]
     stack = build_stack(cfg.navigation, robot, episode, local_planner=planner)
-    nav = NavigationController(stack, generator.runtime(episode), robot)
+    nav = NavigationController(
+        stack, generator.runtime(episode), robot, cfg.navigation.scan_sensor
+    )
     runner = EpisodeRunner(backend, cfg.sim.dt, [nav, _CrowdNavRewards(logs, robot.radius)], nav)
     crowd = build_driver(cfg.crowd, cfg.pedestrians)
     runner.reset(episode, crowd, cfg.seed)

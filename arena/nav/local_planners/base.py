@@ -8,7 +8,9 @@ that respects the robot's velocity box and acceleration limits.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import TYPE_CHECKING, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
@@ -17,6 +19,7 @@ from numpy.typing import NDArray
 from arena.core.registry import Registry
 from arena.core.types import Pose2D
 from arena.robots.limits import VelocityLimits
+from arena.sensors.spec import LidarReading
 
 if TYPE_CHECKING:
     from arena.nav.costmap import Costmap
@@ -53,7 +56,12 @@ class LocalObservation:
         scan_ranges: ``(beams,)`` laser ranges (m); ``inf``/``nan`` mean no return. Beams with
             no hit may also report the sensor's ``range_max``.
         scan_angles: ``(beams,)`` beam angles (rad) in the robot frame, mount yaw included.
-        scan_origin: ``(2,)`` sensor position in the robot frame (m).
+        scan_origin: ``(2,)`` sensor position in the robot frame (m). The three ``scan_*``
+            fields are the lidar the navigation stack reads (``navigation.scan_sensor``,
+            default ``laser``).
+        sensors: every sensor of the robot by name: a lidar as a
+            :class:`~arena.sensors.spec.LidarReading` (ranges, angles, origin), another type
+            as its reading array. Empty when the caller gives only the ``scan_*`` fields.
         time: simulation time (s).
         kinematics: the robot's kinematics name (one of :data:`KINEMATICS`), or ``None`` to let
             the planner infer it from ``limits`` (see :func:`infer_kinematics`).
@@ -80,6 +88,9 @@ class LocalObservation:
     scan_ranges: NDArray[np.float64] = field(default_factory=_empty)
     scan_angles: NDArray[np.float64] = field(default_factory=_empty)
     scan_origin: NDArray[np.float64] = field(default_factory=_zero2)
+    sensors: Mapping[str, LidarReading | NDArray[np.float64]] = field(
+        default_factory=lambda: MappingProxyType({})
+    )
     time: float = 0.0
     kinematics: str | None = None
     goal_yaw_tolerance: float | None = None

@@ -8,7 +8,7 @@ static geometry plus its :class:`DynamicGeometry` (pedestrians, robot bodies). E
 same per-sensor function as :meth:`Lidar2D.scan_many <arena.sensors.lidar2d.Lidar2D.scan_many>`
 (:func:`~arena.sensors.lidar2d.kernels._scan_one`), so a row's ranges are bit-identical to a
 :class:`~arena.sensors.lidar2d.Lidar2D` scan of the same scene; see :mod:`.model` for what a
-beam hits. The bank draws no noise: :meth:`LidarBank.add_noise` applies a row's noise from the
+beam hits. The bank draws no noise: :meth:`LidarBank.read` applies a row's noise from the
 caller's generator.
 
 Static tables are packed in flat buffers (layout: :mod:`.bank_kernels`). A grid is converted
@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import SimulationError
 from arena.maps.grid import OccupancyGrid
+from arena.sensors.base import SENSORS
 from arena.sensors.lidar2d.bank_kernels import (
     BAD_POSE,
     BAD_SCENE,
@@ -169,14 +170,17 @@ class _MapSlot:
 _EMPTY_OWNER = np.zeros(0, dtype=np.int64)
 
 
+@SENSORS.register("lidar2d")
 class LidarBank:
-    """Every lidar of every world, scanned in one kernel call.
+    """Every lidar of every world, scanned in one kernel call: the ``lidar2d`` sensor bank.
 
     Usage: ``bank = LidarBank()``; when world ``w`` resets, ``bank.bind_world(w, grid, a, b)``;
     after any reset ``bank.set_sensors(row_world, row_robot, specs)``; per step
     ``bank.scan(due, poses, scene)`` and read ``bank.ranges(s)``. One caller at a time: the
     work arrays are per pool thread, not per caller.
     """
+
+    Params = LidarSpec
 
     def __init__(self) -> None:
         self._dist = _Blocks(((), np.float32))
@@ -467,6 +471,17 @@ class LidarBank:
         if code == BAD_POSE:
             raise SimulationError("LidarBank: the poses of the scanning robots must be finite")
 
+    def read(self, s: int, rng: np.random.Generator | None) -> F64:
+        """Row ``s``'s latest ranges with their noise drawn from ``rng``: a new array.
+
+        The :class:`~arena.sensors.base.SensorBank` reading: the bank's own ranges stay as
+        scanned; the noise is :meth:`add_noise`'s (none when ``rng`` is ``None``).
+        """
+        out = self.ranges(s).copy()  # the bank overwrites its own with the next scan
+        if rng is not None and self._row_specs[s].noise_std > 0.0:  # the usual: no call
+            self._noise(s, out, rng)
+        return out
+
     def add_noise(self, s: int, rng: np.random.Generator) -> None:
         """Add row ``s``'s range noise, drawn from ``rng``, to its latest ranges.
 
@@ -474,9 +489,12 @@ class LidarBank:
         :meth:`Lidar2D.scan <arena.sensors.lidar2d.Lidar2D.scan>` draws per scan), nothing
         otherwise; max-range returns stay, the rest is clipped to the range limits.
         """
+        self._noise(s, self.ranges(s), rng)
+
+    def _noise(self, s: int, ranges: F64, rng: np.random.Generator) -> None:
+        """Row ``s``'s noise added to ``ranges`` ``(num_beams,)`` in place."""
         spec = self._row_specs[s]
         if spec.noise_std > 0.0:
-            out = self.ranges(s)[None]
-            _add_noise(out, rng.standard_normal(out.shape), spec.noise_std, spec.range_min,
+            row = ranges[None]
+            _add_noise(row, rng.standard_normal(row.shape), spec.noise_std, spec.range_min,
                        spec.range_max)
-

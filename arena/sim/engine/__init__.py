@@ -3,7 +3,8 @@
 See :mod:`arena.sim.engine.engine`.
 """
 
-from arena.sim.engine.engine import Engine, PaddedAgents
+from arena.sim.engine.agents import PaddedAgents
+from arena.sim.engine.engine import Engine
 from arena.sim.engine.params import EngineParams
 from arena.sim.engine.scene import DynamicScene
 

@@ -9,8 +9,10 @@ single run of its episode (``tests/sim/engine/test_equivalence.py``).
 
 Flat layout: the robots of all worlds are global rows ``0..R-1``, world ``w`` owning rows
 ``robot_off[w]:robot_off[w + 1]`` (poses ``(R, 3)`` ``[x m, y m, θ rad]``, twists and commands
-``(R, 3)`` ``[vx m/s, vy m/s, ω rad/s]``); sensors are rows ``0..S-1`` of ``sensor_off``, each
-carried by robot row ``sensor_robot[s]``; the pedestrians of world ``w`` are rows
+``(R, 3)`` ``[vx m/s, vy m/s, ω rad/s]``); sensors are rows ``0..S-1`` of ``sensor_off`` (per
+world, per robot, in the order of the robot's ``sensors`` mapping), each carried by robot row
+``sensor_robot[s]``, named ``sensor_name[s]``, of registered type ``sensor_kind[s]``, its latest
+reading ``scans[s]``; the pedestrians of world ``w`` are rows
 ``ag_off[w]:ag_off[w + 1]`` of ``ag_pos`` ``(A, 2)`` m and ``ag_r`` ``(A,)`` m. Indices reported
 per world (contacts) are local to it; ``-1`` is none. Every array is replaced by a step, never
 written in place, so a caller may keep what it read.
@@ -24,13 +26,15 @@ the thread count.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import TypeVar
 
 import numba
 import numpy as np
 from numpy.typing import NDArray
+from pydantic import BaseModel
 
 from arena.core.errors import SimulationError
 from arena.core.types import Pose2D
@@ -38,10 +42,10 @@ from arena.robots.kinematics.base import Kinematics
 from arena.robots.model import RobotModel
 from arena.scene.episode import Episode
 from arena.scene.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
-from arena.sensors.lidar2d.bank import LidarBank
-from arena.sensors.spec import LidarSpec
+from arena.sensors.base import SensorBank
 from arena.sim.backend import PedestrianDriver, split_rng
 from arena.sim.contacts import ContactBank, Footprint
+from arena.sim.engine.agents import PaddedAgents, pad_agents, standing_agents
 from arena.sim.engine.params import EngineParams
 from arena.sim.engine.stages import (
     ContactStage,
@@ -58,32 +62,25 @@ B1 = NDArray[np.bool_]
 T = TypeVar("T")
 
 
-@dataclass(frozen=True, eq=False)
-class PaddedAgents:
-    """The pedestrians of all worlds padded to ``P`` slots: ``(W, P, ...)`` arrays.
+_NO_READING = np.zeros(0)
+_NO_READING.flags.writeable = False
 
-    Attributes:
-        positions: ``(W, P, 2)`` m (padding 0).
-        velocities: ``(W, P, 2)`` m/s (padding 0).
-        headings: ``(W, P)`` rad (padding 0).
-        radii: ``(W, P)`` m (padding 0).
-        kinds: ``(W, P)`` type codes (padding -1).
-        states: ``(W, P)`` social-state codes (padding -1).
-        mask: ``(W, P)`` bool, the slot holds a pedestrian.
+
+def robot_sensors(model: RobotModel) -> tuple[tuple[str, str, BaseModel], ...]:
+    """``(name, type, params)`` of each sensor a robot model carries, in sensor-row order.
+
+    The one place the engine learns a robot's sensors (``model.sensors``, validated through
+    :data:`~arena.sensors.base.SENSORS`, each params declaring its ``type``).
     """
-
-    positions: F64
-    velocities: F64
-    headings: F64
-    radii: F64
-    kinds: I64
-    states: I64
-    mask: B1
+    return tuple((name, str(spec.type), spec) for name, spec in model.sensors.items())
 
 
-def robot_lidars(model: RobotModel) -> tuple[LidarSpec, ...]:
-    """The lidar specs a robot model carries, in sensor-row order."""
-    return (model.laser,)
+@dataclass(frozen=True)
+class _RobotSensors:
+    """World-local sensor rows of one robot: ``(name, row)`` each and its primary lidar's row."""
+
+    rows: tuple[tuple[str, int], ...]
+    primary: int  # -1: no lidar2d
 
 
 class Engine:
@@ -107,7 +104,6 @@ class Engine:
             self.params.pedestrians_block_lidar and self.params.pedestrian_body == "legs"
         )
         self.contacts = ContactBank()
-        self.lidars = LidarBank()
         self.crowd_stage = CrowdStage()
         self.kinematics_stage = KinematicsStage()
         self.contact_stage = ContactStage()
@@ -156,7 +152,12 @@ class Engine:
         self.sensor_world = np.zeros(0, dtype=np.int64)
         self.sensor_world_list: list[int] = []  # the same as Python ints (per-step loops)
         self.sensor_robot = np.zeros(0, dtype=np.int64)
-        self.specs: list[LidarSpec] = []
+        self.sensor_name: list[str] = []
+        self.sensor_kind: list[str] = []  # registry name of the row's type (its bank)
+        self.sensor_local: list[int] = []  # the row's index in its bank
+        self.sensor_bank: list[SensorBank] = []  # the row's bank
+        self._robot_sensors: list[tuple[_RobotSensors, ...]] = [()] * w_n
+        self.specs: list[BaseModel] = []
         self.scan_period: list[float] = []
         self.last_scan: list[float] = []
         self.scans: list[F64] = []
@@ -221,7 +222,7 @@ class Engine:
         world = StaticWorld.build(ep.grid, ep.obstacles)
         self.static_worlds[w] = world
         self.contacts.bind_world(w, world)
-        self.lidars.bind_world(w, world.grid, world.segments_a, world.segments_b)
+        self.sensor_stage.bind_world(w, world)
         crowd_rng, self.sensor_rng[w] = split_rng(rng)
         self.crowd_rng[w] = crowd_rng
         self._names[w] = tuple(r.name for r in robots)
@@ -229,7 +230,7 @@ class Engine:
         self.drivers[w] = driver
         self.agents[w] = (
             driver.reset(ep.agents, world, crowd_rng) if driver is not None
-            else _standing_agents(ep)
+            else standing_agents(ep)
         )
         self.walked[w] = np.zeros(len(self.agents[w]))
         self.time[w] = 0.0
@@ -249,7 +250,10 @@ class Engine:
         fps: list[Footprint] = []
         kins: list[Kinematics] = []
         polys_w: list[tuple[F64 | None, ...]] = []
-        s_specs: list[LidarSpec] = []
+        s_specs: list[BaseModel] = []
+        s_names: list[str] = []
+        s_kinds: list[str] = []
+        per_robot: list[tuple[_RobotSensors, ...]] = []
         s_last: list[float] = []
         s_scans: list[F64] = []
         s_robot: list[int] = []
@@ -273,13 +277,25 @@ class Engine:
                     for p, m in zip(polys, models, strict=True)
                 )
                 kins.extend(self._kinematics(m) for m in models)
+                first = len(s_specs)
+                mine: list[_RobotSensors] = []
                 for j, m in enumerate(models):
-                    for spec in robot_lidars(m):
+                    named: list[tuple[str, int]] = []
+                    for name, kind, spec in robot_sensors(m):
+                        named.append((name, len(s_specs) - first))
                         s_specs.append(spec)
+                        s_names.append(name)
+                        s_kinds.append(kind)
                         s_last.append(-math.inf)
-                        s_scans.append(np.full(spec.num_beams, spec.range_max))
+                        s_scans.append(_NO_READING)  # the bank's initial reading, below
                         s_robot.append(row0 + j)
                         s_world.append(w)
+                    primary = m.primary_lidar
+                    mine.append(_RobotSensors(
+                        tuple(named),
+                        dict(named)[primary] if primary is not None else -1,
+                    ))
+                per_robot.append(tuple(mine))
             else:
                 a, b = int(self.robot_off[w]), int(self.robot_off[w + 1])
                 poses.append(self.poses[a:b])
@@ -293,6 +309,9 @@ class Engine:
                 kins.extend(self.kinematics[a:b])
                 s0, s1 = int(self.sensor_off[w]), int(self.sensor_off[w + 1])
                 s_specs.extend(self.specs[s0:s1])
+                s_names.extend(self.sensor_name[s0:s1])
+                s_kinds.extend(self.sensor_kind[s0:s1])
+                per_robot.append(self._robot_sensors[w])
                 s_last.extend(self.last_scan[s0:s1])
                 s_scans.extend(self.scans[s0:s1])
                 s_robot.extend(int(r) - a + row0 for r in self.sensor_robot[s0:s1])
@@ -324,11 +343,19 @@ class Engine:
         self.sensor_world_list = s_world
         self.sensor_robot = np.array(s_robot, dtype=np.int64)
         self.specs = s_specs
-        self.scan_period = [1.0 / s.update_rate for s in s_specs]
+        self.sensor_name = s_names
+        self.sensor_kind = s_kinds
+        self._robot_sensors = per_robot
+        self.scan_period = [1.0 / float(s.update_rate) for s in s_specs]  # type: ignore[attr-defined]
         self.last_scan = s_last
-        self.scans = s_scans
         self.contacts.set_robots(self.row_world, fps)
-        self.lidars.set_sensors(self.sensor_world, self.sensor_robot, s_specs)
+        self.sensor_local, self.sensor_bank = self.sensor_stage.set_rows(
+            self, s_kinds, s_world, s_robot, s_specs
+        )
+        for s, reading in enumerate(s_scans):
+            if reading is _NO_READING:  # a fresh row: what its bank reads before a scan
+                s_scans[s] = _frozen(self.sensor_bank[s].read(self.sensor_local[s], None))
+        self.scans = s_scans
 
     def _footprint(self, polygon: F64 | None, radius: float) -> Footprint:
         """``Footprint.make(polygon, radius)``, the same object while the inputs are equal."""
@@ -477,11 +504,36 @@ class Engine:
             return snap.robots
         a, b = self._robot_off_l[w], self._robot_off_l[w + 1]
         s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
+        scans, sensors = self._readings(w, self.scans[s0:s1])
         return RobotStates(
             names=self._names[w], models=self._models[w], poses=self.poses[a:b],
             twists=self.twists[a:b], commands=self.commands[a:b], radii=self.radii[a:b],
-            footprints=self._polys[w], scans=tuple(self.scans[s0:s1]),
+            footprints=self._polys[w], scans=scans, sensors=sensors,
         )
+
+    def _readings(
+        self, w: int, readings: list[F64]
+    ) -> tuple[tuple[F64, ...], tuple[Mapping[str, F64], ...]]:
+        """World ``w``'s per-robot primary lidar scans and sensors by name from its rows."""
+        per_robot = self._robot_sensors[w]
+        if len(per_robot) == 1 and len(per_robot[0].rows) == 1:  # the usual case, kept cheap
+            rs = per_robot[0]
+            r = readings[0]
+            return (r if rs.primary == 0 else _NO_READING,), (MappingProxyType({rs.rows[0][0]: r}),)
+        scans = tuple(readings[rs.primary] if rs.primary >= 0 else _NO_READING
+                      for rs in per_robot)
+        sensors = tuple(MappingProxyType({name: readings[k] for name, k in rs.rows})
+                        for rs in per_robot)
+        return scans, sensors
+
+    def sensor_rows(self, name: str) -> I64:
+        """``(R,)`` global sensor row of each robot row's sensor ``name`` (``-1``: none)."""
+        out = np.full(self.poses.shape[0], -1, dtype=np.int64)
+        for s, (n, r) in enumerate(zip(self.sensor_name, self.sensor_robot.tolist(),
+                                       strict=True)):
+            if n == name:
+                out[r] = s
+        return out
 
     # -- views ---------------------------------------------------------------------------------
     def world_state(self, w: int) -> SimState:
@@ -491,25 +543,26 @@ class Engine:
             return snap
         if not self._ready[w]:
             raise SimulationError("the backend has not been reset with an episode yet")
-        scans = self.scans
+        s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
+        # the readings are read-only arrays the engine replaces, never writes: shared
+        readings = self.scans[s0:s1]
+        scans, sensors = self._readings(w, readings)
         if self.num_worlds == 1:
             # Every row is world 0's. The commands and contact flags are arrays of this step
             # that the engine replaces and never reads back into the simulation: shared.
             robots = RobotStates(
                 names=self._names[0], models=self._models[0], poses=self.poses.copy(),
                 twists=self.twists.copy(), commands=self.commands, radii=self.radii.copy(),
-                footprints=self._polys[0],
-                scans=(scans[0].copy(),) if len(scans) == 1 else tuple(s.copy() for s in scans),
+                footprints=self._polys[0], scans=scans, sensors=sensors,
             )
             collisions = Collisions(self.wall, self.obstacle, self.agent, self.robot)
         else:
             rows = slice(self._robot_off_l[w], self._robot_off_l[w + 1])
-            s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
             robots = RobotStates(
                 names=self._names[w], models=self._models[w], poses=self.poses[rows].copy(),
                 twists=self.twists[rows].copy(), commands=self.commands[rows].copy(),
-                radii=self.radii[rows].copy(), footprints=self._polys[w],
-                scans=tuple(s.copy() for s in scans[s0:s1]),
+                radii=self.radii[rows].copy(), footprints=self._polys[w], scans=scans,
+                sensors=sensors,
             )
             collisions = Collisions(
                 self.wall[rows].copy(), self.obstacle[rows].copy(), self.agent[rows].copy(),
@@ -525,48 +578,16 @@ class Engine:
 
     def padded_agents(self) -> PaddedAgents:
         """Every world's pedestrians padded to the largest crowd (built once per step)."""
-        if self._padded is not None:
-            return self._padded
-        w_n = self.num_worlds
-        counts = np.diff(self.ag_off)
-        p = int(counts.max()) if w_n else 0
-        world = np.repeat(np.arange(w_n), counts)
-        slot = np.arange(int(self.ag_off[-1])) - self.ag_off[world]
-        ags = self.agents
-        pos = np.zeros((w_n, p, 2))
-        vel = np.zeros((w_n, p, 2))
-        head = np.zeros((w_n, p))
-        rad = np.zeros((w_n, p))
-        kinds = np.full((w_n, p), -1, dtype=np.int64)
-        states = np.full((w_n, p), -1, dtype=np.int64)
-        mask = np.zeros((w_n, p), dtype=bool)
-        if world.size:
-            pos[world, slot] = self.ag_pos
-            rad[world, slot] = self.ag_r
-            vel[world, slot] = np.concatenate([a.velocities for a in ags])
-            head[world, slot] = np.concatenate([a.headings for a in ags])
-            kinds[world, slot] = np.concatenate([a.kinds for a in ags])
-            states[world, slot] = np.concatenate([a.states for a in ags])
-            mask[world, slot] = True
-        self._padded = PaddedAgents(pos, vel, head, rad, kinds, states, mask)
+        if self._padded is None:
+            self._padded = pad_agents(self.agents, self.ag_off, self.ag_pos, self.ag_r)
         return self._padded
+
+def _frozen(a: F64) -> F64:
+    """``a`` made read-only (readings are shared by snapshots and their keys)."""
+    a.flags.writeable = False
+    return a
 
 
 def _no_flags(n: int) -> tuple[B1, I64, I64, I64]:
     neg = np.full(n, -1, dtype=np.int64)
     return np.zeros(n, dtype=bool), neg, neg.copy(), neg.copy()
-
-
-def _standing_agents(episode: Episode) -> AgentStates:
-    """The episode's pedestrians standing at their spawn (no driver)."""
-    sp = episode.agents
-    n = len(sp)
-    return AgentStates(
-        ids=np.arange(n, dtype=np.int64),
-        positions=sp.positions.astype(np.float64, copy=True),
-        velocities=np.zeros((n, 2)),
-        headings=np.zeros(n),
-        radii=sp.radii.astype(np.float64, copy=True),
-        kinds=sp.kinds.astype(np.int64, copy=True),
-        states=np.zeros(n, dtype=np.int64),
-    )

@@ -10,16 +10,19 @@ out, so a caller may keep them).
 from __future__ import annotations
 
 import math
+from functools import partial
 from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numba import njit
 from numpy.typing import NDArray
+from pydantic import BaseModel
 
 from arena.core.errors import SimulationError
 from arena.robots.kinematics.base import Kinematics, KinematicState, box_step_rows
-from arena.sensors.lidar2d.kernels import _add_noise
-from arena.sim.engine.scene import SceneBuilder, pedestrian_circles
+from arena.scene.state import StaticWorld
+from arena.sensors.base import SENSORS, SensorBank
+from arena.sim.engine.scene import DynamicScene, SceneBuilder, pedestrian_circles
 
 if TYPE_CHECKING:
     from arena.sim.engine.engine import Engine
@@ -170,22 +173,67 @@ def _hold_blocked(
 
 
 class SensorStage:
-    """Lidar scans of the sensor rows whose period elapsed; the others hold their last scan.
+    """Readings of the sensor rows whose period elapsed; the others hold their last reading.
 
-    Noise is added per world from that world's sensor stream: one ``(1, beams)`` normal draw
-    per due scan with ``noise_std > 0``, in sensor-row order (as ``Lidar2D.scan`` draws).
+    One bank per sensor type present (:data:`~arena.sensors.base.SENSORS`: the ``lidar2d``
+    :class:`~arena.sensors.lidar2d.LidarBank` for lidars), built when a robot first carries the
+    type: a new type plugs in by registering, without touching this stage. Sensor row ``s``
+    is row ``engine.sensor_local[s]`` of the bank of type ``engine.sensor_kind[s]``. Noise is
+    added per world from that world's sensor stream, per due row in sensor-row order (a lidar
+    draws one ``(1, beams)`` normal per scan with ``noise_std > 0``, as ``Lidar2D.scan`` does).
     """
 
     def __init__(self) -> None:
         self._scene = SceneBuilder()
-        self._all_due = np.ones(0, dtype=bool)  # every row due (never written)
+        self.banks: dict[str, SensorBank] = {}
+        self._bank_rows: dict[str, int] = {}
+        self._all_due: dict[int, NDArray[np.bool_]] = {}  # every row due (never written)
+
+    def bank(self, engine: Engine, kind: str) -> SensorBank:
+        """The bank of sensor type ``kind``, built and bound to every loaded world if new."""
+        bank = self.banks.get(kind)
+        if bank is None:
+            bank = SENSORS.get(kind)()
+            for w, world in enumerate(engine.static_worlds):
+                if world is not None:
+                    bank.bind_world(w, world.grid, world.segments_a, world.segments_b)
+            self.banks[kind] = bank
+        return bank
+
+    def bind_world(self, w: int, world: StaticWorld) -> None:
+        """World ``w``'s static part, for every bank built so far."""
+        for bank in self.banks.values():
+            bank.bind_world(w, world.grid, world.segments_a, world.segments_b)
+
+    def set_rows(
+        self, engine: Engine, kinds: list[str], worlds: list[int], robots: list[int],
+        specs: list[BaseModel],
+    ) -> tuple[list[int], list[SensorBank]]:
+        """Hand each bank its rows; returns each sensor row's index within its bank and bank."""
+        local: list[int] = []
+        per: dict[str, tuple[list[int], list[int], list[BaseModel]]] = {k: ([], [], []) for k in
+                                                                      self.banks}
+        for kind, w, r, spec in zip(kinds, worlds, robots, specs, strict=True):
+            if kind not in per:
+                self.bank(engine, kind)
+                per[kind] = ([], [], [])
+            rows = per[kind]
+            local.append(len(rows[0]))
+            rows[0].append(w)
+            rows[1].append(r)
+            rows[2].append(spec)
+        for kind, (ws, rs, ss) in per.items():
+            self.banks[kind].set_sensors(ws, rs, ss)
+            self._bank_rows[kind] = len(ws)
+        return local, [self.banks[k] for k in kinds]
 
     def _due(self, n: int, rows: list[int]) -> NDArray[np.bool_]:
         """``(n,)`` bool, true on ``rows``."""
-        if len(rows) == n:  # the usual case: every lidar runs at the period of the step
-            if self._all_due.shape[0] != n:
-                self._all_due = np.ones(n, dtype=bool)
-            return self._all_due
+        if len(rows) == n:  # the usual case: every sensor runs at the period of the step
+            due = self._all_due.get(n)
+            if due is None:
+                due = self._all_due[n] = np.ones(n, dtype=bool)
+            return due
         due = np.zeros(n, dtype=bool)
         for s in rows:
             due[s] = True
@@ -195,7 +243,7 @@ class SensorStage:
         """Nothing to do: the engine scans reset worlds through :meth:`scan`."""
 
     def step(self, engine: Engine, commands: F64, dt: float) -> None:
-        """Scan the due rows (a 10 Hz lidar in a faster simulation holds its scan)."""
+        """Read the due rows (a 10 Hz lidar in a faster simulation holds its scan)."""
         if not engine.params.lidar:
             return
         times = engine.time
@@ -209,15 +257,14 @@ class SensorStage:
             self._scan_rows(engine, rows)
 
     def scan(self, engine: Engine, due: NDArray[np.bool_]) -> None:
-        """Scan the rows of ``due`` ``(S,)`` now (their hold restarts)."""
+        """Read the rows of ``due`` ``(S,)`` now (their hold restarts)."""
         rows = np.flatnonzero(due).tolist()
         if engine.params.lidar and rows:
             self._scan_rows(engine, rows)
 
     def _scan_rows(self, engine: Engine, rows: list[int]) -> None:
-        """Scan sensor rows ``rows`` (ascending), add their noise, restart their hold."""
+        """Read sensor rows ``rows`` (ascending), add their noise, restart their hold."""
         p = engine.params
-        due = self._due(len(engine.specs), rows)
         agents, walked = engine.agents, engine.walked
         peds = (
             [pedestrian_circles(agents[0], walked[0], p)] if len(agents) == 1
@@ -227,26 +274,36 @@ class SensorStage:
             peds, engine.robot_off, engine.poses, engine.radii, engine.placed_polygons()
         )
         poses = engine.poses
-        engine.in_pool(
-            len(rows),
-            lambda parallel: engine.lidars.scan(
-                due, poses, scene, parallel=parallel, chunksize=p.parallel_chunksize
-            ),
-        )
+        chunk = p.parallel_chunksize
+        local = engine.sensor_local
+        for kind, bank in self.banks.items():
+            if len(self.banks) == 1:  # one type: its rows are the sensor rows, in order
+                mine = rows
+            else:
+                kind_of = engine.sensor_kind
+                mine = [local[s] for s in rows if kind_of[s] == kind]
+                if not mine:
+                    continue
+            due = self._due(self._bank_rows[kind], mine)
+            engine.in_pool(len(mine), partial(_scan, bank, due, poses, scene, chunk))
         scans = list(engine.scans)
-        world_of = engine.sensor_world_list
+        world_of, row_bank, rngs = engine.sensor_world_list, engine.sensor_bank, engine.sensor_rng
+        times, last = engine.time, engine.last_scan
         for s in rows:
             w = world_of[s]
-            engine.last_scan[s] = engine.time[w]
-            # a copy: the bank overwrites its output with the next scan
-            out = engine.lidars.ranges(s).copy()
-            spec = engine.specs[s]
-            if spec.noise_std > 0.0:
-                row = out[None]
-                z = engine.sensor_rng[w].standard_normal(row.shape)
-                _add_noise(row, z, spec.noise_std, spec.range_min, spec.range_max)
-            scans[s] = out
+            last[s] = times[w]
+            reading = row_bank[s].read(local[s], rngs[w])
+            reading.flags.writeable = False  # shared by the snapshots: never written
+            scans[s] = reading
         engine.scans = scans
+
+
+def _scan(
+    bank: SensorBank, due: NDArray[np.bool_], poses: F64, scene: DynamicScene, chunk: int,
+    parallel: bool,
+) -> None:
+    """``bank.scan`` of its ``due`` rows (for :meth:`Engine.in_pool`)."""
+    bank.scan(due, poses, scene, parallel=parallel, chunksize=chunk)
 
 
 def check_step(n: int, commands: F64, dt: float) -> F64:

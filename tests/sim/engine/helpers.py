@@ -51,6 +51,10 @@ def assert_same_state(a: SimState, b: SimState, where: str) -> None:
     assert len(ra.scans) == len(rb.scans), where
     for sa, sb in zip(ra.scans, rb.scans, strict=True):
         assert np.array_equal(sa, sb), f"{where}: scans"
+    for ma, mb in zip(ra.sensors, rb.sensors, strict=True):  # every sensor, by name
+        assert list(ma) == list(mb), where
+        for name in ma:
+            assert np.array_equal(ma[name], mb[name]), f"{where}: sensors[{name!r}]"
     for name in ("wall", "obstacle", "agent", "robot"):
         assert np.array_equal(getattr(a.collisions, name), getattr(b.collisions, name)), (
             f"{where}: collisions.{name}"
