@@ -184,7 +184,9 @@ class CrowdSimulator:
         )
         s.velocities = v
         # NumPy's arctan2 on these strided views, as always (its SIMD and scalar paths differ).
-        s.headings = _face_motion(v, np.arctan2(v[:, 1], v[:, 0]), s.headings)
+        headings = np.empty(v.shape[0])  # allocated here: cheaper than boxing a returned array
+        _face_motion(v, np.arctan2(v[:, 1], v[:, 0]), s.headings, headings)
+        s.headings = headings
         if self.social is not None:
             self.social.orient(s)
         s.forces = out.forces
@@ -214,7 +216,11 @@ class CrowdSimulator:
         Leaders and loners within tolerance of their waypoint take the next. Usually nobody
         arrives, and the destinations computed with the arrival test stand.
         """
-        arrived, dest = _arrivals(
+        n = s.positions.shape[0]
+        # outputs allocated here: cheaper than boxing arrays a compiled function returns
+        arrived = np.empty(n, dtype=np.bool_)
+        dest = np.empty((n, 2))
+        _arrivals(
             s.positions,
             s.waypoints,
             s.waypoint_index,
@@ -224,6 +230,8 @@ class CrowdSimulator:
             self.config.waypoint_tolerance,
             self._members,
             self._offsets,
+            arrived,
+            dest,
         )
         if not np.count_nonzero(arrived):
             s.destinations = dest
@@ -240,9 +248,9 @@ class CrowdSimulator:
     def _update_destinations(self) -> None:
         """Own waypoint for leaders and loners; the leader's, offset on a ring, for members."""
         s = self.state
-        s.destinations = _destinations(
-            s.waypoints, s.waypoint_index, s.leader, self._members, self._offsets
-        )
+        dest = np.empty((s.waypoints.shape[0], 2))
+        _destinations(s.waypoints, s.waypoint_index, s.leader, self._members, self._offsets, dest)
+        s.destinations = dest
 
     @staticmethod
     def _ring_offsets(rank: NDArray[np.int64], spacing: float) -> FloatArray:
@@ -474,7 +482,9 @@ def _arrivals(
     tolerance: float,
     members: NDArray[np.int64],
     offsets: FloatArray,
-) -> tuple[NDArray[np.bool_], FloatArray]:
+    arrived: NDArray[np.bool_],
+    dest: FloatArray,
+) -> None:
     """Leaders and loners that have reached their waypoint, and :func:`_destinations`.
 
     Reached: started and within ``max(tolerance, radius)`` (m) of the waypoint; ``hypot`` is
@@ -490,14 +500,13 @@ def _arrivals(
         tolerance: m.
         members: ``(g,)`` the agents that follow a leader.
         offsets: ``(g, 2)`` their ring offsets (m).
-
-    Returns:
-        ``(arrived (n,) bool, destinations (n, 2) m)``, the destinations for the current
-        waypoints (stale for the agents that arrived).
+        arrived: ``(n,)`` bool, written: reached.
+        dest: ``(n, 2)`` m, written: the destinations for the current waypoints (stale for
+            the agents that arrived).
     """
     n = positions.shape[0]
-    arrived = np.zeros(n, dtype=np.bool_)
     for i in range(n):
+        arrived[i] = False
         if leader[i] != i or not started[i]:
             continue
         k = waypoint_index[i]
@@ -505,7 +514,7 @@ def _arrivals(
         tol = r if (r > tolerance or r != r) else tolerance  # np.maximum: NaN wins
         d = math.hypot(positions[i, 0] - waypoints[i, k, 0], positions[i, 1] - waypoints[i, k, 1])
         arrived[i] = d < tol
-    return arrived, _destinations(waypoints, waypoint_index, leader, members, offsets)
+    _destinations(waypoints, waypoint_index, leader, members, offsets, dest)
 
 
 @njit(cache=True)
@@ -515,7 +524,8 @@ def _destinations(
     leader: NDArray[np.int64],
     members: NDArray[np.int64],
     offsets: FloatArray,
-) -> FloatArray:
+    dest: FloatArray,
+) -> None:
     """Each agent's current waypoint; group members take their leader's plus a ring offset.
 
     Args:
@@ -524,12 +534,9 @@ def _destinations(
         leader: ``(n,)`` group leader index.
         members: ``(g,)`` the agents that follow a leader.
         offsets: ``(g, 2)`` their ring offsets (m).
-
-    Returns:
-        ``(n, 2)`` m, a fresh array.
+        dest: ``(n, 2)`` m, written.
     """
     n = waypoints.shape[0]
-    dest = np.empty((n, 2))
     for i in range(n):
         k = waypoint_index[i]
         dest[i, 0] = waypoints[i, k, 0]
@@ -538,26 +545,23 @@ def _destinations(
         m = members[q]
         dest[m, 0] = dest[leader[m], 0] + offsets[q, 0]
         dest[m, 1] = dest[leader[m], 1] + offsets[q, 1]
-    return dest
 
 
 @njit(cache=True)
-def _face_motion(velocities: FloatArray, angles: FloatArray, headings: FloatArray) -> FloatArray:
+def _face_motion(
+    velocities: FloatArray, angles: FloatArray, headings: FloatArray, out: FloatArray
+) -> None:
     """Headings after a step: the motion's direction for agents faster than 1 mm/s.
 
     Args:
         velocities: ``(n, 2)`` m/s.
         angles: ``(n,)`` their directions (rad).
         headings: ``(n,)`` the previous headings (rad).
-
-    Returns:
-        ``(n,)`` rad, a fresh array.
+        out: ``(n,)`` rad, written: the new headings.
     """
-    out = np.empty(headings.shape[0])
     for i in range(out.shape[0]):
         moving = math.hypot(velocities[i, 0], velocities[i, 1]) > 1e-3  # libm's, as NumPy's
         out[i] = angles[i] if moving else headings[i]
-    return out
 
 
 def form_groups(

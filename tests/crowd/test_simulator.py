@@ -351,7 +351,8 @@ def test_route_kernels_are_the_numpy_expressions():
     started = rng.random(n) < 0.8
     radii = rng.uniform(0.2, 0.7, n)
     radii[7] = np.nan
-    arrived, dest = _arrivals(pos, wps, idx, leader, started, radii, 0.5, members, offsets)
+    arrived, dest = np.empty(n, dtype=bool), np.empty((n, 2))
+    _arrivals(pos, wps, idx, leader, started, radii, 0.5, members, offsets, arrived, dest)
     rows = np.arange(n)
     target = wps[rows, idx]
     tol = np.maximum(0.5, radii)
@@ -361,7 +362,9 @@ def test_route_kernels_are_the_numpy_expressions():
     wp = target.copy()
     wp[members] = wp[leader[members]] + offsets
     assert dest.tobytes() == wp.tobytes()
-    assert _destinations(wps, idx, leader, members, offsets).tobytes() == wp.tobytes()
+    again = np.empty((n, 2))
+    _destinations(wps, idx, leader, members, offsets, again)
+    assert again.tobytes() == wp.tobytes()
 
 
 def test_robot_view_and_headings_are_the_numpy_expressions():
@@ -385,7 +388,9 @@ def test_robot_view_and_headings_are_the_numpy_expressions():
     heads = rng.uniform(-3, 3, 40)
     angles = np.arctan2(v[:, 1], v[:, 0])
     want_h = np.where(np.hypot(v[:, 0], v[:, 1]) > 1e-3, angles, heads)
-    assert _face_motion(v, angles, heads).tobytes() == want_h.tobytes()
+    got_h = np.empty(40)
+    _face_motion(v, angles, heads, got_h)
+    assert got_h.tobytes() == want_h.tobytes()
 
 
 def test_integrate_factors_are_the_premultiplied_arrays():

@@ -202,6 +202,8 @@ class LidarBank:
         self._max_robot = -1
         self._max_world = -1
         self._bound = True  # every row's world has been bound (checked at the next scan)
+        # the kernel's static arguments, gathered once after each bind_world/set_sensors
+        self._static: tuple[tuple[Any, ...], tuple[Any, ...]] | None = None
         self._specs: list[LidarSpec] = []  # distinct specs, in order of first use
         self._beam_off = np.zeros(1, dtype=np.int64)
         self._cos = np.zeros(0)
@@ -230,6 +232,7 @@ class LidarBank:
         """
         if w < 0:
             raise SimulationError(f"world index must be >= 0, got {w}")
+        self._static = None
         a = _points(segments_a, "segments_a")
         b = _points(segments_b, "segments_b")
         if a.shape != b.shape:
@@ -312,6 +315,7 @@ class LidarBank:
         position among its rows with an equal spec (the worlds that did not reset keep their
         held scans); other rows read ``range_max`` until scanned.
         """
+        self._static = None
         worlds = np.array(row_world, dtype=np.int64).reshape(-1)
         robots = np.array(row_robot, dtype=np.int64).reshape(-1)
         specs = tuple(specs)
@@ -428,10 +432,10 @@ class LidarBank:
                 split). Which thread casts a row never changes its ranges.
         """
         flags = np.asarray(due, dtype=bool)
-        if flags.shape != (self.num_rows,):
+        if flags.shape != (len(self._row_specs),):
             raise SimulationError(f"due must have shape ({self.num_rows},), got {flags.shape}")
-        rows = np.flatnonzero(flags)
-        if len(rows) == 0:
+        rows = flags.nonzero()[0]  # (np.flatnonzero costs five times as much per step)
+        if rows.shape[0] == 0:
             return
         q = np.asarray(poses, dtype=np.float64)
         if q.ndim != 2 or q.shape[1] != 3 or q.shape[0] <= self._max_robot:
@@ -443,18 +447,21 @@ class LidarBank:
                 if w >= len(self._world_slot) or self._world_slot[w] is None:
                     raise SimulationError(f"LidarBank.bind_world({w}, ...) was never called")
             self._bound = True  # worlds are never unbound
-        for name in ("circ_off", "seg_off"):
-            off = getattr(scene, name)
-            if off.ndim != 1 or len(off) <= self._max_world + 1:
-                raise SimulationError(f"scene.{name} must have a row per world plus one")
+        circ_off, seg_off = scene.circ_off, scene.seg_off
+        need = self._max_world + 1
+        if circ_off.ndim != 1 or circ_off.shape[0] <= need:
+            raise SimulationError("scene.circ_off must have a row per world plus one")
+        if seg_off.ndim != 1 or seg_off.shape[0] <= need:
+            raise SimulationError("scene.seg_off must have a row per world plus one")
+        static = self._static
+        if static is None:
+            static = self._static = self._static_args()
+        head, tail = static
         args = (
-            rows, q, self._row_robot, self._row_world, self._row_spec, self._out_off,
-            self._beam_off, self._cos, self._sin, self._spec_f,
-            self._map_i, self._map_f, self._dist.data[0], self._faces.data[0], self._use_faces,
-            self._world_i, self._segs.data[0], self._segs.data[1], _EMPTY_OWNER,
-            scene.circ_off, scene.circ_xy, scene.circ_r, scene.circ_owner,
-            scene.seg_off, scene.seg_a, scene.seg_b, scene.seg_owner,
-            self._scratch_f, self._scratch_i, self._out,
+            rows, q, *head,
+            circ_off, scene.circ_xy, scene.circ_r, scene.circ_owner,
+            seg_off, scene.seg_a, scene.seg_b, scene.seg_owner,
+            *tail,
         )
         if parallel:
             previous = numba.set_parallel_chunksize(chunksize)
@@ -470,6 +477,19 @@ class LidarBank:
             )
         if code == BAD_POSE:
             raise SimulationError("LidarBank: the poses of the scanning robots must be finite")
+
+    def _static_args(self) -> tuple[tuple[Any, ...], tuple[Any, ...]]:
+        """The kernel's arguments before and after the scene's.
+
+        Valid until the next :meth:`bind_world` or :meth:`set_sensors`, which may replace any.
+        """
+        head = (
+            self._row_robot, self._row_world, self._row_spec, self._out_off,
+            self._beam_off, self._cos, self._sin, self._spec_f,
+            self._map_i, self._map_f, self._dist.data[0], self._faces.data[0], self._use_faces,
+            self._world_i, self._segs.data[0], self._segs.data[1], _EMPTY_OWNER,
+        )
+        return head, (self._scratch_f, self._scratch_i, self._out)
 
     def read(self, s: int, rng: np.random.Generator | None) -> F64:
         """Row ``s``'s latest ranges with their noise drawn from ``rng``: a new array.

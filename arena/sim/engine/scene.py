@@ -26,9 +26,11 @@ _EMPTY_R = np.zeros(0)
 _EMPTY_I = np.zeros(0, dtype=np.int64)
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(slots=True, eq=False)  # not frozen: built every step, and a frozen init costs 1 µs
 class DynamicScene:
     """Circles and segments of every world; world ``w`` owns ``off[w]:off[w + 1]`` of each.
+
+    Read-only by convention: nothing writes into a scene after :meth:`SceneBuilder.build`.
 
     Attributes:
         circ_off: ``(W + 1,)`` int64 circle offsets per world.

@@ -274,10 +274,11 @@ class SensorStage:
             peds, engine.robot_off, engine.poses, engine.radii, engine.placed_polygons()
         )
         poses = engine.poses
-        chunk = p.parallel_chunksize
         local = engine.sensor_local
-        for kind, bank in self.banks.items():
-            if len(self.banks) == 1:  # one type: its rows are the sensor rows, in order
+        banks = self.banks
+        for kind in banks:
+            bank = banks[kind]
+            if len(banks) == 1:  # one type: its rows are the sensor rows, in order
                 mine = rows
             else:
                 kind_of = engine.sensor_kind
@@ -285,7 +286,11 @@ class SensorStage:
                 if not mine:
                     continue
             due = self._due(self._bank_rows[kind], mine)
-            engine.in_pool(len(mine), partial(_scan, bank, due, poses, scene, chunk))
+            if engine.parallel(len(mine)):
+                engine.in_pool(len(mine), partial(_scan, bank, due, poses, scene,
+                                                  p.parallel_chunksize))
+            else:  # the usual single world: no pool, no closure
+                bank.scan(due, poses, scene)
         scans = list(engine.scans)
         world_of, row_bank, rngs = engine.sensor_world_list, engine.sensor_bank, engine.sensor_rng
         times, last = engine.time, engine.last_scan
