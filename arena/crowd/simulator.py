@@ -23,6 +23,7 @@ from numba import njit
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
+from arena.core.records import frozen_record
 from arena.crowd.base import CrowdFrame, CrowdModel, RobotView
 from arena.crowd.integrator import integrate_guarded, wall_guard
 from arena.crowd.neighbors import find_neighbors
@@ -143,7 +144,8 @@ class CrowdSimulator:
             self.social.pre(s, view, self._world, dt)
         active = s.started.copy()
         neighbors = find_neighbors(s.positions, self.model.neighbor_cutoff())
-        frame = CrowdFrame(
+        frame = frozen_record(  # CrowdFrame(...) without its slower generated __init__
+            CrowdFrame,
             state=s,
             destinations=s.destinations.copy(),
             active=active,
@@ -262,7 +264,8 @@ class CrowdSimulator:
         return np.stack([r * np.cos(angle), r * np.sin(angle)], axis=1)
 
     def _snapshot(self, s: CrowdState) -> AgentStates:
-        return AgentStates(
+        return frozen_record(
+            AgentStates,
             ids=s.ids.copy(),
             positions=s.positions.copy(),
             velocities=s.velocities.copy(),

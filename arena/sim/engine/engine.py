@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 from pydantic import BaseModel
 
 from arena.core.errors import SimulationError
+from arena.core.records import frozen_record
 from arena.core.types import Pose2D
 from arena.robots.kinematics.base import Kinematics
 from arena.robots.model import RobotModel
@@ -505,7 +506,8 @@ class Engine:
         a, b = self._robot_off_l[w], self._robot_off_l[w + 1]
         s0, s1 = self._sensor_off_l[w], self._sensor_off_l[w + 1]
         scans, sensors = self._readings(w, self.scans[s0:s1])
-        return RobotStates(
+        return frozen_record(
+            RobotStates,
             names=self._names[w], models=self._models[w], poses=self.poses[a:b],
             twists=self.twists[a:b], commands=self.commands[a:b], radii=self.radii[a:b],
             footprints=self._polys[w], scans=scans, sensors=sensors,
@@ -550,25 +552,34 @@ class Engine:
         if self.num_worlds == 1:
             # Every row is world 0's. The commands and contact flags are arrays of this step
             # that the engine replaces and never reads back into the simulation: shared.
-            robots = RobotStates(
+            robots = frozen_record(
+                RobotStates,
                 names=self._names[0], models=self._models[0], poses=self.poses.copy(),
                 twists=self.twists.copy(), commands=self.commands, radii=self.radii.copy(),
                 footprints=self._polys[0], scans=scans, sensors=sensors,
             )
-            collisions = Collisions(self.wall, self.obstacle, self.agent, self.robot)
+            collisions = frozen_record(
+                Collisions, wall=self.wall, obstacle=self.obstacle, agent=self.agent,
+                robot=self.robot,
+            )
         else:
             rows = slice(self._robot_off_l[w], self._robot_off_l[w + 1])
-            robots = RobotStates(
+            robots = frozen_record(
+                RobotStates,
                 names=self._names[w], models=self._models[w], poses=self.poses[rows].copy(),
                 twists=self.twists[rows].copy(), commands=self.commands[rows].copy(),
                 radii=self.radii[rows].copy(), footprints=self._polys[w], scans=scans,
                 sensors=sensors,
             )
-            collisions = Collisions(
-                self.wall[rows].copy(), self.obstacle[rows].copy(), self.agent[rows].copy(),
-                self.robot[rows].copy(),
+            collisions = frozen_record(
+                Collisions, wall=self.wall[rows].copy(), obstacle=self.obstacle[rows].copy(),
+                agent=self.agent[rows].copy(), robot=self.robot[rows].copy(),
             )
-        snap = SimState(self.time[w], self.step_count[w], robots, self.agents[w], collisions)
+        # frozen_record: these records' generated __init__ would cost more than the copies
+        snap = frozen_record(
+            SimState, time=self.time[w], step=self.step_count[w], robots=robots,
+            agents=self.agents[w], collisions=collisions,
+        )
         self._snapshots[w] = snap
         return snap
 
