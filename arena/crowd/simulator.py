@@ -436,7 +436,10 @@ def robot_view(robots: RobotStates) -> RobotView:
     cos, sin = np.cos(th), np.sin(th)
     # Outputs allocated here: cheaper than boxing arrays a numba function returns.
     r = th.shape[0]
-    view = RobotView(np.empty((r, 2)), np.empty(r), np.empty((r, 2)), robots.radii.copy())
+    view = frozen_record(
+        RobotView, positions=np.empty((r, 2)), headings=np.empty(r),
+        velocities=np.empty((r, 2)), radii=robots.radii.copy(),
+    )
     _robot_frame(robots.poses, robots.twists, cos, sin, view.positions, view.headings,
                  view.velocities)
     return view
