@@ -17,6 +17,7 @@ field of view and principal point. OpenGL's rows run bottom-up; frames are flipp
 order (row 0 at the top). The z-buffer is MuJoCo's reversed one (1 at ``near``, 0 at ``far``);
 depth is linearised from it with the spec's ``near``/``far`` (not ``model.vis.map``, whose
 ``znear``/``zfar`` are fractions of ``model.stat.extent`` and apply to MuJoCo's own cameras).
+Frames carry no noise; :func:`add_depth_noise` adds the spec's from a given generator.
 """
 
 from __future__ import annotations
@@ -214,3 +215,20 @@ class RgbdCamera:
             if g.objtype == geom and g.segid >= 0:
                 lut[g.segid + 1] = self._person_of_geom[g.objid]
         return lut[np.minimum(code, scene.ngeom + 1)]
+
+
+def add_depth_noise(
+    depth: NDArray[np.float32], spec: RgbdSpec, rng: np.random.Generator
+) -> NDArray[np.float32]:
+    """A copy of ``depth`` ``(H, W)`` (m) with the spec's Gaussian depth noise.
+
+    One ``(H, W)`` standard normal draw when ``depth_noise_std > 0`` (none otherwise), added to
+    the valid pixels only (``0``, no return, stays ``0``), clipped to ``[near, far]``.
+    """
+    out = np.array(depth, dtype=np.float32)
+    if spec.depth_noise_std > 0.0:
+        z = rng.standard_normal(out.shape)
+        valid = out > 0
+        noisy = np.clip(out + spec.depth_noise_std * z, spec.near, spec.far)
+        out[valid] = noisy[valid]
+    return out

@@ -20,7 +20,7 @@ try:
 except ConfigError:
     pytest.skip("3-D worlds need the mujoco extra (arena[3d])", allow_module_level=True)
 
-from arena.sim.mujoco.camera import RgbdCamera, camera_pose
+from arena.sim.mujoco.camera import RgbdCamera, add_depth_noise, camera_pose
 
 ROOM = OccupancyGrid.empty(10.0, 6.0, 0.1)  # inner wall faces at x = 0.1, 9.9 and y = 0.1, 5.9
 
@@ -222,3 +222,22 @@ def test_camera_without_gl_is_one_line(room, monkeypatch):
     with pytest.raises(ConfigError, match=r"^no working OpenGL .*libEGL.so.1: cannot open .*"
                                           r"run tools/install_gl.sh"):
         RgbdCamera(model, cam_spec())
+
+
+def test_depth_noise_from_the_given_generator(room):
+    model, data = room
+    spec = cam_spec(depth_noise_std=0.2, far=8.0)
+    depth = RgbdCamera(model, spec, segmentation=False).render(data, (2.0, 3.0, 0.0)).depth
+    a = add_depth_noise(depth, spec, np.random.default_rng(5))
+    b = add_depth_noise(depth, spec, np.random.default_rng(5))
+    assert a.dtype == np.float32 and a.tobytes() == b.tobytes()
+    valid = depth > 0
+    assert valid.any() and (~valid).any()
+    assert (a[~valid] == 0).all()  # no return stays no return
+    z = np.random.default_rng(5).standard_normal(depth.shape)  # one (H, W) draw
+    want = np.clip(depth + 0.2 * z, spec.near, spec.far)
+    np.testing.assert_allclose(a[valid], want[valid], rtol=1e-6)
+    assert a.max() <= 8.0
+    rng = np.random.default_rng(9)
+    assert np.array_equal(add_depth_noise(depth, cam_spec(), rng), depth)
+    assert rng.standard_normal() == np.random.default_rng(9).standard_normal()  # no draw
