@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,6 +12,7 @@ from pydantic import ValidationError
 
 from arena.core.errors import ConfigError
 from arena.core.rng import derive_rng
+from arena.robots import presets
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.sensors import SENSORS, LidarSpec
@@ -36,6 +39,30 @@ def test_a_robot_declares_rgbd_and_lidar3d_and_keeps_its_primary_lidar():
     again = RobotModel.model_validate(model.model_dump())  # a dumped robot reloads
     assert again.sensors["cam"] == model.sensors["cam"]
     assert again.sensors["vlp"] == model.sensors["vlp"]
+
+
+def test_a_robot_yaml_declares_them_and_a_bad_field_is_one_line(tmp_path):
+    jackal = (Path(presets.__file__).parent / "presets" / "jackal.yaml").read_text()
+    assert "\nlaser:" in jackal  # Arena's layout: one laser block, read as sensors.laser
+    body = re.sub(r"^laser:\n((?:  .*\n)+)", lambda m: "sensors:\n  laser:\n    type: lidar2d\n"
+                  + m.group(1).replace("  ", "    "), jackal, count=1, flags=re.MULTILINE)
+    block = ("  cam: {type: rgbd, width: 64, height: 48, fx: 50, fy: 50, cx: 31.5, cy: 23.5,\n"
+             "        mount: [0.2, 0, 0.4, 0, 0.1]}\n"
+             "  vlp: {type: lidar3d, rings: 4, num_beams: 90, range_max: 20,"
+             " mount: [0, 0, 0.5, 0]}\n")
+    path = tmp_path / "robot.yaml"
+    path.write_text(body.replace("sensors:\n", "sensors:\n" + block, 1))
+    model = load_robot(str(path))
+    assert model.sensors["cam"].intrinsics() == (50, 50, 31.5, 23.5)
+    assert model.sensors["vlp"].directions().shape == (4, 90, 3)
+    assert model.primary_lidar == "laser"
+    path.write_text(body.replace("sensors:\n", "sensors:\n" + block.replace("fy: 50", "fy: 40"),
+                                 1))
+    with pytest.raises(ConfigError) as e:
+        load_robot(str(path))
+    msg = str(e.value)
+    assert "\n" not in msg and str(path) in msg and "sensors.cam" in msg
+    assert "fx (50.0) must equal fy (40.0)" in msg
 
 
 def test_every_3d_type_is_registered_with_its_params():
