@@ -208,13 +208,16 @@ class RgbdCamera:
         mj.mjr_readPixels(self._seg, None, self._rect, self._ctx)
         s = self._seg.astype(np.int32)
         code = s[..., 0] | (s[..., 1] << 8) | (s[..., 2] << 16)  # segid + 1; 0: background
-        lut = np.full(scene.ngeom + 2, -1, dtype=np.int32)  # the last: codes out of range
         geom = int(mj.mjtObj.mjOBJ_GEOM)
-        for k in range(scene.ngeom):
-            g = scene.geoms[k]
-            if g.objtype == geom and g.segid >= 0:
-                lut[g.segid + 1] = self._person_of_geom[g.objid]
-        return lut[np.minimum(code, scene.ngeom + 1)]
+        pairs = [(g.segid + 1, self._person_of_geom[g.objid])
+                 for g in (scene.geoms[k] for k in range(scene.ngeom))
+                 if g.objtype == geom and g.segid >= 0]
+        top = max((c for c, _ in pairs), default=0) + 1
+        lut = np.full(top + 1, -1, dtype=np.int32)  # lut[top]: any code out of range
+        for c, pid in pairs:
+            lut[c] = pid
+        out: NDArray[np.int32] = lut[np.minimum(code, top)]
+        return out
 
 
 def add_depth_noise(
