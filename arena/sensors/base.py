@@ -84,8 +84,10 @@ class SensorBank(Protocol):
 SENSORS: Registry[SensorBank] = Registry(
     "sensor",
     entry_points="arena.sensors",
-    builtins={"lidar2d": "arena.sensors.lidar2d.bank"},
+    builtins={"lidar2d": "arena.sensors.lidar2d.bank", "rgbd": "arena.sensors.needs3d",
+              "lidar3d": "arena.sensors.needs3d"},
     # validating a robot does not import the numba scanning code
-    params={"lidar2d": "arena.sensors.spec:LidarSpec"},
+    params={"lidar2d": "arena.sensors.spec:LidarSpec", "rgbd": "arena.sensors.spec3d:RgbdSpec",
+            "lidar3d": "arena.sensors.spec3d:Lidar3DSpec"},
 )
 """Sensor types by YAML ``type:`` name; each entry is the type's :class:`SensorBank` class."""

@@ -43,31 +43,48 @@ class LidarSpec(BaseModel):
 
     @model_validator(mode="after")
     def _check(self) -> LidarSpec:
-        if self.angle_max < self.angle_min:
-            raise ValueError(
-                f"angle_max ({self.angle_max}) must be >= angle_min ({self.angle_min})"
-            )
-        if self.angle_max - self.angle_min > 2 * math.pi + 1e-3:
-            raise ValueError("the scan spans more than a full circle")
-        if self.range_min >= self.range_max:
-            raise ValueError(f"range_min ({self.range_min}) must be < range_max ({self.range_max})")
+        check_fan(self.angle_min, self.angle_max, self.range_min, self.range_max)
         return self
 
     @property
     def full_circle(self) -> bool:
         """Whether the beams cover 360° (no duplicate beam at the seam)."""
-        return self.angle_max - self.angle_min >= 2 * math.pi - 1e-3
+        return is_full_circle(self.angle_min, self.angle_max)
 
     @property
     def angle_increment(self) -> float:
         """Angle between neighbouring beams (rad)."""
-        if self.full_circle:
-            return 2 * math.pi / self.num_beams
-        return (self.angle_max - self.angle_min) / max(self.num_beams - 1, 1)
+        return fan_increment(self.angle_min, self.angle_max, self.num_beams)
 
     def angles(self) -> NDArray[np.float64]:
         """Beam angles in the sensor frame, shape ``(num_beams,)`` (rad)."""
         return self.angle_min + self.angle_increment * np.arange(self.num_beams, dtype=np.float64)
+
+
+def check_fan(angle_min: float, angle_max: float, range_min: float, range_max: float) -> None:
+    """Validate a fan of beams (rad) and its range limits (m); ``ValueError`` saying what."""
+    if angle_max < angle_min:
+        raise ValueError(f"angle_max ({angle_max}) must be >= angle_min ({angle_min})")
+    if angle_max - angle_min > 2 * math.pi + 1e-3:
+        raise ValueError("the scan spans more than a full circle")
+    if range_min >= range_max:
+        raise ValueError(f"range_min ({range_min}) must be < range_max ({range_max})")
+
+
+def is_full_circle(angle_min: float, angle_max: float) -> bool:
+    """Whether a fan from ``angle_min`` to ``angle_max`` (rad) covers 360°."""
+    return angle_max - angle_min >= 2 * math.pi - 1e-3
+
+
+def fan_increment(angle_min: float, angle_max: float, n: int) -> float:
+    """Angle (rad) between neighbouring beams of ``n`` spread from ``angle_min`` to ``angle_max``.
+
+    A full circle spreads them evenly without repeating the first beam; otherwise the first
+    and last beams sit at ``angle_min`` and ``angle_max`` (one beam: at ``angle_min``).
+    """
+    if is_full_circle(angle_min, angle_max):
+        return 2 * math.pi / n
+    return (angle_max - angle_min) / max(n - 1, 1)
 
 
 @dataclass(frozen=True, eq=False)

@@ -134,7 +134,7 @@ def test_laser_is_the_sensor_named_laser_else_the_first_lidar():
 @pytest.mark.parametrize(
     ("sensors", "path", "fragment"),
     [
-        ({"laser": {**FRONT, "type": "lidar3d"}}, "sensors.laser.type", "did you mean 'lidar2d'"),
+        ({"laser": {**FRONT, "type": "lidar2"}}, "sensors.laser.type", "did you mean 'lidar2d'"),
         ({"rear": {**REAR, "num_beam": 3}}, "sensors.rear.num_beam", "unknown key"),
         ({"rear": {**REAR, "num_beams": 0}}, "sensors.rear.num_beams", "greater than 0"),
         ({"rear left": REAR}, "sensors.rear left", "identifier"),

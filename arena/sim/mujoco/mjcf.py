@@ -16,6 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from arena.core.errors import ConfigError
+from arena.sim.mujoco.gl import choose_gl
 from arena.sim.mujoco.scene import Body, Scene3D
 
 if TYPE_CHECKING:
@@ -79,11 +80,14 @@ def to_mjcf(scene: Scene3D) -> str:
 def import_mujoco() -> Any:
     """The ``mujoco`` module, or a one-line error saying how to install it.
 
-    Without a display, offscreen rendering goes through EGL unless ``MUJOCO_GL`` says otherwise
-    (``osmesa`` for machines without a GPU driver); MuJoCo reads the variable on import.
+    Without a display, offscreen rendering goes through EGL or OSMesa, whichever is installed,
+    unless ``MUJOCO_GL`` says otherwise (:func:`.gl.choose_gl`); MuJoCo reads the variable on
+    import.
     """
-    if "mujoco" not in sys.modules and not os.environ.get("DISPLAY"):
-        os.environ.setdefault("MUJOCO_GL", "egl")
+    if "mujoco" not in sys.modules:
+        backend = choose_gl()
+        if backend is not None:
+            os.environ["MUJOCO_GL"] = backend
     try:
         import mujoco
     except ImportError:

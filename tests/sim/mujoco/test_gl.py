@@ -1,0 +1,57 @@
+"""Headless GL: EGL or OSMesa picked by itself, a one-line error saying what to install."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import pytest
+
+from arena.core.errors import ConfigError
+from arena.sim.mujoco.gl import INSTALL_HINT, choose_gl, open_context
+
+
+def libs(*found: str):
+    return lambda name: f"lib{name}.so.1" if name in found else None
+
+
+@pytest.mark.parametrize(("env", "found", "want"), [
+    ({}, ("EGL", "OSMesa"), "egl"),
+    ({}, ("OSMesa",), "osmesa"),
+    ({}, (), "egl"),  # nothing found: EGL, whose context error then says what to install
+    ({"MUJOCO_GL": "osmesa"}, ("EGL",), None),  # the user's choice wins
+    ({"DISPLAY": ":0"}, ("EGL",), None),  # a display: MuJoCo's default (GLFW)
+    ({"WAYLAND_DISPLAY": "wayland-0"}, ("EGL",), None),
+])
+def test_choose_gl(env, found, want):
+    assert choose_gl(env, libs(*found)) == want
+
+
+class Broken:
+    def __init__(self, width: int, height: int) -> None:
+        raise RuntimeError("Cannot initialize a EGL device display.\nmore detail")
+
+
+class Fine:
+    def __init__(self, width: int, height: int) -> None:
+        self.size = (width, height)
+        self.current = False
+
+    def make_current(self) -> None:
+        self.current = True
+
+
+def test_open_context_failure_is_one_line_with_what_to_install(monkeypatch):
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    for fake in (SimpleNamespace(GLContext=Broken), SimpleNamespace()):
+        with pytest.raises(ConfigError) as e:
+            open_context(fake, 320, 240)
+        msg = str(e.value)
+        assert "\n" not in msg
+        assert msg.startswith("no working OpenGL for MuJoCo's offscreen rendering "
+                              "(MUJOCO_GL='egl': ")
+        assert msg.endswith(INSTALL_HINT)
+        assert "tools/install_gl.sh" in msg and "libegl1" in msg
+    with pytest.raises(ConfigError, match=r": Cannot initialize a EGL device display\.\); run"):
+        open_context(SimpleNamespace(GLContext=Broken), 1, 1)  # its first line only
+    ctx = open_context(SimpleNamespace(GLContext=Fine), 320, 240)
+    assert ctx.size == (320, 240) and ctx.current
