@@ -17,6 +17,7 @@ from arena.core.types import Pose2D
 from arena.crowd.models.walker import WaypointWalker
 from arena.crowd.simulator import CrowdSimulator, PedestrianConfig
 from arena.experiment import run_experiment
+from arena.learn.env import SocialNavEnv
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.scene.state import AgentStates
@@ -238,3 +239,29 @@ def test_an_episode_with_people_ends_as_on_native2d(tmp_path):
         assert res.error in ("", None), res.error
         outcomes[kind] = res.outcome
     assert outcomes["mujoco"] == outcomes["native2d"] == "success"
+
+
+def test_the_gym_env_runs_on_mujoco():
+    room = ["map.type=empty", "map.width=8", "map.height=8", "task.obstacles.static=0",
+            "task.robots.min_goal_distance=3"]
+    still = [*room, "task.obstacles.dynamic=0"]
+    deep = SocialNavEnv(None, ["sim.backend.type=mujoco", *still], robot="jackal")
+    flat = SocialNavEnv(None, still, robot="jackal")
+    assert isinstance(deep.driver.backend, MujocoBackend)
+    od, _ = deep.reset(seed=1)
+    of, _ = flat.reset(seed=1)
+    for key in ("goal", "last_action", "lidar"):  # an empty room: the same observation
+        assert np.allclose(od[key], of[key], atol=1e-5), key
+    runs = []
+    for _ in range(2):  # with people: the same seed, the same episode
+        env = SocialNavEnv(None, ["sim.backend.type=mujoco", *room,
+                                  "task.obstacles.dynamic=3"], robot="jackal")
+        env.action_space.seed(5)
+        obs, _ = env.reset(seed=2)
+        seen = [obs["lidar"]]
+        for _ in range(20):
+            obs, *_ = env.step(env.action_space.sample())
+            seen.append(obs["lidar"])
+        runs.append(np.array(seen))
+    assert np.array_equal(runs[0], runs[1])
+    assert not np.array_equal(runs[0][0], runs[0][-1])
