@@ -85,7 +85,8 @@ class MujocoContactStage(ContactStage):
     def _build(self, engine: Engine, ep: Episode) -> MjWorld:
         robots = [(r.name, r.model, engine.poses[k]) for k, r in enumerate(ep.robots)]
         world = MjWorld(ep.grid, ep.obstacles, robots, engine.agents[0], self.params.world,
-                        name=ep.map_name, source=f"map {ep.map_name!r}")
+                        name=ep.map_name, source=f"map {ep.map_name!r}",
+                        people_in_lidar=self.params.pedestrians_block_lidar)
         world.place_people(engine.agents[0])
         return world
 

@@ -12,7 +12,10 @@ What a beam sees is the 3-D world at the scan height: wall boxes (the map's cell
 the obstacle models' parts at that height (a table's legs, not its top), the other robots'
 bodies, and of a person what the figure has there (below the hips: two leg capsules swinging
 with the gait, instead of the 2-D body circle). With ``pedestrians_block_lidar: false`` the
-people's geoms (geom group :data:`~arena.sim.mujoco.sim.PERSON_GROUP`) are skipped.
+people's geoms (geom group :data:`~arena.sim.mujoco.sim.PERSON_GROUP`) are skipped. A scan plane
+below :data:`~arena.sim.mujoco.sim.HIGH_Z` skips the geoms entirely above it (their group
+:data:`~arena.sim.mujoco.sim.HIGH_GROUP`): they cannot be hit, and ``mj_multiRay`` tests every
+geom it is given against every beam.
 """
 
 from __future__ import annotations
@@ -27,7 +30,7 @@ from arena.core.errors import SimulationError
 from arena.sensors.lidar2d.kernels import _add_noise
 from arena.sensors.spec import LidarSpec
 from arena.sim.mujoco.contacts import MjHandle
-from arena.sim.mujoco.sim import PERSON_GROUP
+from arena.sim.mujoco.sim import HIGH_GROUP, HIGH_Z, PERSON_GROUP
 
 F64 = NDArray[np.float64]
 
@@ -82,13 +85,14 @@ class MujocoLidar2DBank:
         mj = world._mj
         q = np.asarray(poses, dtype=np.float64)
         fixed = self._handle.params.lidar_height
-        group = None if self._handle.params.pedestrians_block_lidar else _NO_PEOPLE
+        people = self._handle.params.pedestrians_block_lidar
         for s in np.flatnonzero(np.asarray(due, dtype=bool)).tolist():
             spec, r = self._specs[s], self._robot[s]
             x, y, th = q[r]
             c, si = np.cos(th), np.sin(th)
             mx, my = spec.mount[0], spec.mount[1]
             z = fixed if fixed is not None else LIDAR_HEIGHT_FRACTION * world.robot_height[r]
+            group = _GROUPS[(bool(z >= HIGH_Z), people)]
             pnt = np.array([x + c * mx - si * my, y + si * mx + c * my, z])
             vec = self._vec[s]
             ca, sa = self._cos[s], self._sin[s]
@@ -117,4 +121,15 @@ class MujocoLidar2DBank:
         return out
 
 
-_NO_PEOPLE = np.array([1 if g != PERSON_GROUP else 0 for g in range(6)], dtype=np.uint8)
+def _groups(high: bool, people: bool) -> NDArray[np.uint8]:
+    """The geom groups a ray cast takes (a ``(6,)`` mask).
+
+    The high geoms only from a plane that can reach them; the people only when they are seen.
+    """
+    mask = np.ones(6, dtype=np.uint8)
+    mask[HIGH_GROUP] = high
+    mask[PERSON_GROUP] = people
+    return mask
+
+
+_GROUPS = {(h, p): _groups(h, p) for h in (False, True) for p in (False, True)}

@@ -34,8 +34,16 @@ B1 = NDArray[np.bool_]
 NOTHING, WALL, OBSTACLE, PERSON, ROBOT = range(5)
 """What a geom belongs to (:attr:`MjWorld.geom_kind`)."""
 
+HIGH_Z = 0.5
+"""m: geoms whose lowest point is above this height (table tops, the people's upper bodies)
+are in :data:`HIGH_GROUP`; a horizontal scan plane below it leaves them out of its ray cast."""
+
+HIGH_GROUP = 1
+"""Geom group of the geoms entirely above :data:`HIGH_Z` (when people are seen: theirs too)."""
+
 PERSON_GROUP = 2
-"""Geom group of the people's geoms (visible by default; a ray cast may leave it out)."""
+"""Geom group of the people's geoms below :data:`HIGH_Z` (their legs); when the lidar does not
+see people, of all their geoms. Groups 0-2 are all visible in MuJoCo's default render options."""
 
 
 class MjWorld:
@@ -66,6 +74,7 @@ class MjWorld:
         *,
         name: str = "arena",
         source: str = "map",
+        people_in_lidar: bool = True,
     ) -> None:
         mujoco = import_mujoco()
         self._mj = mujoco
@@ -109,16 +118,30 @@ class MjWorld:
                 b = model.body(f"person/{i}{part}").id
                 mocap[i, j] = model.body_mocapid[b]
                 body_kind[b], body_index[b] = PERSON, i
-        self._mocap = mocap.reshape(-1)
-        self._kinds = np.asarray(agents.kinds).copy()
         self.geom_kind = body_kind[model.geom_bodyid]
         self.geom_index = body_index[model.geom_bodyid]
         self.person_of_geom = np.where(self.geom_kind == PERSON, self.geom_index, -1)
-        model.geom_group[self.geom_kind == PERSON] = PERSON_GROUP
+        self._mocap = mocap.reshape(-1)
+        self._kinds = np.asarray(agents.kinds).copy()
         self._walked = np.zeros(n)
         self._last_xy: F64 | None = None
         # the per-robot qpos block [x, y, z, qw, qx, qy, qz] is written from the poses
         self._qidx = (self._qpos[:, None] + np.arange(7)[None, :]).reshape(-1)
+        self._group_geoms(people_in_lidar)
+
+    def _group_geoms(self, people_in_lidar: bool) -> None:
+        """Geom groups for the ray casts (:data:`HIGH_GROUP`, :data:`PERSON_GROUP`).
+
+        Heights are taken at the start poses: bodies only turn about z (a leg pitches, but
+        hangs from the hip, below it), so a geom's lowest point stays where it is.
+        """
+        m, d = self.model, self.data
+        self.forward()
+        bottom = d.geom_xpos[:, 2] + m.geom_aabb[:, 2] - m.geom_aabb[:, 5]
+        high = (bottom > HIGH_Z) & (self.geom_kind != ROBOT)
+        person = self.geom_kind == PERSON
+        m.geom_group[high] = HIGH_GROUP
+        m.geom_group[person & (~high | (not people_in_lidar))] = PERSON_GROUP
 
     # -- placing -------------------------------------------------------------------------------
     def place_robots(self, poses: F64) -> None:
