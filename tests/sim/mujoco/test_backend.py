@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 from typing import Literal
@@ -10,12 +11,14 @@ import numpy as np
 import pytest
 from pydantic import BaseModel, ConfigDict
 
+from arena import cli
 from arena.config import load_config
 from arena.core.errors import ConfigError
 from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
 from arena.crowd.models.walker import WaypointWalker
 from arena.crowd.simulator import CrowdSimulator, PedestrianConfig
+from arena.eval.store import load_results, read_manifest
 from arena.experiment import run_experiment
 from arena.learn.env import SocialNavEnv
 from arena.robots.model import RobotModel
@@ -27,6 +30,7 @@ from arena.sim.mujoco.backend import MujocoBackend
 from arena.sim.mujoco.mjcf import import_mujoco, to_mjcf
 from arena.sim.mujoco.params import MujocoParams
 from arena.sim.native2d import Native2DBackend
+from tests.eval._suites import stage
 from tests.sim.engine.helpers import assert_same_state
 from tests.sim.mujoco.scenes import episode, people
 
@@ -265,3 +269,36 @@ def test_the_gym_env_runs_on_mujoco():
         runs.append(np.array(seen))
     assert np.array_equal(runs[0], runs[1])
     assert not np.array_equal(runs[0][0], runs[0][-1])
+
+
+def test_arena_bench_runs_on_mujoco_and_resumes_only_on_it(tmp_path, monkeypatch, capsys):
+    suite, contest = tmp_path / "suite.yaml", tmp_path / "contest.yaml"
+    suite.write_text("stages:\n" + stage("open", 1, "jackal", dynamic=(2, 2)))
+    contest.write_text("contestants:\n  - {name: pp, local_planner: pure_pursuit}\n")
+    run = tmp_path / "run"
+
+    def call(*args: str) -> tuple[int, str]:
+        monkeypatch.setattr(sys, "argv", ["arena", "bench", str(suite), *args])
+        try:
+            cli.main()
+            code = 0
+        except SystemExit as e:
+            code = int(e.code or 0)
+        return code, capsys.readouterr().err
+
+    code, err = call("--contest", str(contest), "--simulator", "mujoco", "--workers", "0",
+                     "-o", str(run), "--no-progress")
+    assert code == 0, err
+    assert read_manifest(run)["simulator"] == "mujoco"
+    (row,) = load_results(run).to_pylist()
+    assert row["outcome"] != "error", row["error"]
+    code, err = call("--resume", str(run), "--workers", "0", "--no-progress")  # the run's own
+    assert code == 0, err
+    code, err = call("--resume", str(run), "--simulator", "native2d", "--no-progress")
+    assert code == 2 and "cannot resume: field 'simulator'" in " ".join(err.split())
+    # a run written before the key existed ran native2d
+    manifest = json.loads((run / "run.json").read_text())
+    del manifest["simulator"]
+    (run / "run.json").write_text(json.dumps(manifest))
+    code, err = call("--resume", str(run), "--simulator", "mujoco", "--no-progress")
+    assert code == 2 and "of the run is 'native2d'" in " ".join(err.split())
