@@ -319,7 +319,8 @@ class SensorStage:
 
 def _registered_bank(kind: str) -> SensorBank:
     """A new bank of the sensor type registered as ``kind`` (the default bank factory)."""
-    return SENSORS.get(kind)()
+    bank: SensorBank = SENSORS.get(kind)()
+    return bank
 
 
 def _scan(
