@@ -105,3 +105,14 @@ def test_noise_is_drawn_from_the_sensor_stream_as_in_native2d():
         diff.append(n - c)
     assert np.std(diff[0]) > 0.01
     assert np.allclose(diff[0], diff[1], atol=1e-9)
+
+
+def test_a_10_hz_lidar_holds_its_scan_between_updates():
+    b = MujocoBackend()
+    first = b.reset(episode(), None, derive_rng(0, "rate")).robots.scans[0]
+    cmd = np.array([[0.5, 0.0, 0.0]])
+    held = b.step(cmd, 0.05)  # 0.05 s after the scan: the 10 Hz lidar holds it
+    assert held.robots.poses[0, 0] > 1.0
+    assert np.array_equal(held.robots.scans[0], first)
+    fresh = b.step(cmd, 0.05).robots.scans[0]  # 0.1 s: a new scan from the moved robot
+    assert not np.array_equal(fresh, first)
