@@ -205,14 +205,16 @@ class _ProbeSpec(BaseModel):
     update_rate: float = 10.0
 
 
-@SENSORS.register("mj_backend_probe")
 class _ProbeBank:
-    """A sensor type only the 2-D engine serves (the MuJoCo backend has no bank for it)."""
+    """A sensor type only the 2-D engine could serve (the MuJoCo backend has no bank for it)."""
 
     Params = _ProbeSpec
 
 
-def test_unserved_sensor_type_and_missing_height_are_one_line_errors():
+def test_unserved_sensor_type_and_missing_height_are_one_line_errors(monkeypatch):
+    # registered for this test only (the sensor conformance test builds every registered bank)
+    monkeypatch.setattr(SENSORS, "_entries", dict(SENSORS._entries))
+    SENSORS.add("mj_backend_probe", _ProbeBank)
     data = load_robot("jackal").model_dump()
     data["sensors"]["probe"] = {"type": "mj_backend_probe"}
     probed = RobotModel.model_validate(data)
