@@ -73,6 +73,12 @@ def bench(
                           "up there first \\[default: the suite's worlds key; resume: the run's]"),
     ] = None,
     plugin: PluginOption = None,
+    simulator: Annotated[
+        str | None,
+        typer.Option("--simulator", metavar="TYPE",
+                     help="simulator backend of every episode (sim.backend.type: native2d, "
+                          "mujoco) \\[default: native2d; resume: the run's]"),
+    ] = None,
     episode_timeout: Annotated[
         float | None,
         typer.Option("--episode-timeout", metavar="SECONDS",
@@ -96,7 +102,7 @@ def bench(
     from arena.config.schema import ExperimentConfig
     from arena.core.errors import ConfigError
     from arena.eval.runner import run_benchmark
-    from arena.eval.store import load_results, read_manifest
+    from arena.eval.store import MANIFEST_DEFAULTS, load_results, read_manifest
 
     load_plugin_options(plugin)
     if resume is not None:
@@ -106,6 +112,8 @@ def bench(
         scale = scale if scale is not None else float(manifest["scale"])
         if worlds is None and manifest.get("worlds") is not None:
             worlds = Path(str(manifest["worlds"]))
+        if simulator is None:  # a run from before the key: native2d
+            simulator = str(manifest.get("simulator", MANIFEST_DEFAULTS["simulator"]))
     contest = contest if contest is not None else "basic"
     seed = seed if seed is not None else 0
     scale = scale if scale is not None else 1.0
@@ -123,10 +131,14 @@ def bench(
             raise ArenaError("--episode-timeout: an episode in this process (--workers 0) "
                              "cannot be stopped; use --workers 1 or more")
         limit["episode_timeout"] = episode_timeout or None
+    simulator = simulator if simulator is not None else "native2d"
     try:
-        base_cfg = ExperimentConfig(seed=seed)
+        base_cfg = ExperimentConfig(seed=seed, sim={"backend": {"type": simulator}})
     except ValidationError as e:  # the schema says what a seed must be
         raise ConfigError(f"{e.errors()[0]['msg']} (got {seed})", source="--seed") from None
+    from arena.sim.backend import BACKENDS
+
+    BACKENDS.validate(base_cfg.sim.backend, source="--simulator")
     if resume is not None and out is not None and resume.resolve() != out.resolve():
         raise ArenaError("give either --resume RUN_DIR or -o RUN_DIR, not two different folders")
     if out is not None and out.exists() and not out.is_dir():

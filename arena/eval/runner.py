@@ -243,7 +243,8 @@ def run_benchmark(
             the suite's own ``scale_episodes``).
         contest: packaged contest name, contest file or a loaded :class:`ContestFile`.
         run_dir: the run folder (created); results land as in :mod:`arena.eval.store`.
-        base_cfg: the experiment every stage derives from (its ``seed`` is the run seed).
+        base_cfg: the experiment every stage derives from (its ``seed`` is the run seed, its
+            ``sim.backend`` the simulator of every episode: its type is kept in the manifest).
         workers: worker processes running the episodes; ``0`` runs them in this process
             (for debugging: no fault isolation, no wall-clock limit, but plugins registered at
             run time in this process are seen). With ``backend="ray"``, the number of tasks
@@ -310,6 +311,7 @@ def run_benchmark(
         "suite": suite_src, "contest": contest_src, "seed": int(base_cfg.seed),
         "scale": float(scale),
         "worlds": None if suite_obj.worlds is None else str(suite_obj.worlds),
+        "simulator": str(base_cfg.sim.backend.get("type", "native2d")),
     }
     check_scale(suite_obj, suite_src)
     jobs = plan_jobs(suite_obj, contest_obj, base_cfg, contest_source=contest_src)
@@ -324,7 +326,8 @@ def run_benchmark(
         try:
             run.mkdir(parents=True, exist_ok=True)
             write_manifest(run, suite=suite_src, contest=contest_src, seed=int(base_cfg.seed),
-                           scale=float(scale), worlds=settings["worlds"])
+                           scale=float(scale), worlds=settings["worlds"],
+                           simulator=settings["simulator"])
         except OSError as e:
             raise ArenaError(f"{run}: cannot create the run folder ({e.strerror or e})") from None
     done = completed(run)

@@ -44,7 +44,10 @@ from arena.eval.record import EpisodeRecord
 MANIFEST = "run.json"
 EPISODES = "episodes"
 #: Manifest keys a resumed run must match.
-MANIFEST_KEYS = ("suite", "contest", "seed", "scale", "worlds")
+MANIFEST_KEYS = ("suite", "contest", "seed", "scale", "worlds", "simulator")
+
+#: What a manifest written before a key existed means by its absence.
+MANIFEST_DEFAULTS: dict[str, Any] = {"simulator": "native2d"}
 
 #: Columns of :func:`load_results` before the metric columns, with their types.
 ID_COLUMNS: tuple[tuple[str, pa.DataType], ...] = (
@@ -106,15 +109,19 @@ def episode_stem(run: Path, contestant: str, stage: str, episode: int) -> Path:
 # -- manifest ---------------------------------------------------------------------------------
 def write_manifest(
     run: str | Path, *, suite: str, contest: str, seed: int, scale: float,
-    worlds: str | None = None,
+    worlds: str | None = None, simulator: str = "native2d",
 ) -> dict[str, Any]:
-    """Write ``<run>/run.json`` for a new run and return it (``worlds``: the worlds folder)."""
+    """Write ``<run>/run.json`` for a new run and return it.
+
+    ``worlds``: the worlds folder; ``simulator``: the ``sim.backend.type`` of every episode.
+    """
     data: dict[str, Any] = {
         "suite": str(suite),
         "contest": str(contest),
         "seed": int(seed),
         "scale": float(scale),
         "worlds": None if worlds is None else str(worlds),
+        "simulator": str(simulator),
         "created": datetime.now(UTC).isoformat(timespec="seconds"),
         "arena_version": __version__,
     }
@@ -132,6 +139,7 @@ class RunManifest(BaseModel):
     seed: StrictInt = Field(ge=0)
     scale: StrictFloat = Field(gt=0)
     worlds: StrictStr | None = Field(None, min_length=1)
+    simulator: StrictStr = Field(MANIFEST_DEFAULTS["simulator"], min_length=1)
 
 
 def read_manifest(run: str | Path) -> dict[str, Any]:
@@ -169,7 +177,7 @@ def check_manifest(run: str | Path, expected: Mapping[str, Any]) -> dict[str, An
     for key in MANIFEST_KEYS:
         if key not in expected:
             continue
-        have, want = data.get(key), expected[key]
+        have, want = data.get(key, MANIFEST_DEFAULTS.get(key)), expected[key]
         same = (
             math.isclose(float(have), float(want))
             if key == "scale" and isinstance(have, int | float)

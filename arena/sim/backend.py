@@ -83,4 +83,10 @@ def split_rng(rng: np.random.Generator) -> tuple[np.random.Generator, np.random.
     return crowd, sensors
 
 
-BACKENDS: Registry[SimulatorBackend] = Registry("simulator backend", entry_points="arena.backends")
+BACKENDS: Registry[SimulatorBackend] = Registry(
+    "simulator backend",
+    entry_points="arena.backends",
+    # mujoco is an optional extra: a config naming it validates without importing it
+    builtins={"mujoco": "arena.sim.mujoco.backend"},
+    params={"mujoco": "arena.sim.mujoco.params:MujocoParams"},
+)

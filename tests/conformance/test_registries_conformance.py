@@ -40,6 +40,8 @@ def test_every_registry_has_a_conformance_test():
 
 @pytest.mark.parametrize("name", BACKENDS.names())
 def test_backend(name):
+    if name == "mujoco":  # the optional extra arena[3d]
+        pytest.importorskip("mujoco")
     check_backend(lambda: BACKENDS.build(name))
     for crowd in CROWD_MODELS.names():
         check_backend(

@@ -94,9 +94,15 @@ class Engine:
     Args:
         num_worlds: ``W``.
         params: engine parameters.
+        contact_stage: the contact stage (default :class:`ContactStage`, the exact 2-D
+            footprints); another simulator swaps in its own (the MuJoCo backend's).
+        sensor_stage: the sensor stage (default :class:`SensorStage` with the registered banks).
     """
 
-    def __init__(self, num_worlds: int, params: EngineParams | None = None) -> None:
+    def __init__(
+        self, num_worlds: int, params: EngineParams | None = None, *,
+        contact_stage: ContactStage | None = None, sensor_stage: SensorStage | None = None,
+    ) -> None:
         if num_worlds < 1:
             raise SimulationError(f"num_worlds must be >= 1, got {num_worlds}")
         self.num_worlds = w_n = int(num_worlds)
@@ -107,8 +113,8 @@ class Engine:
         self.contacts = ContactBank()
         self.crowd_stage = CrowdStage()
         self.kinematics_stage = KinematicsStage()
-        self.contact_stage = ContactStage()
-        self.sensor_stage = SensorStage()
+        self.contact_stage = contact_stage or ContactStage()
+        self.sensor_stage = sensor_stage or SensorStage()
         self.stages: tuple[Stage, ...] = (
             self.crowd_stage, self.kinematics_stage, self.contact_stage, self.sensor_stage,
         )
@@ -209,9 +215,7 @@ class Engine:
         for stage in self.stages:
             stage.reset_worlds(self, idx)
         fresh = np.isin(self.row_world, idx)
-        wall, obstacle, agent, robot = self.in_pool(len(idx), lambda parallel: self.contacts.test(
-            self.poses, None, self.ag_off, self.ag_pos, self.ag_r, rows=fresh, parallel=parallel,
-        ))
+        wall, obstacle, agent, robot = self.contact_stage.test(self, fresh, len(idx))
         self._merge_flags(fresh, wall, obstacle, agent, robot)
         self.sensor_stage.scan(self, np.isin(self.sensor_world, idx))
 
@@ -429,9 +433,7 @@ class Engine:
         self.commands = self.commands.copy()
         self.commands[row] = 0.0
         mine = self.row_world == w
-        wall, obstacle, agent, rob = self.contacts.test(
-            self.poses, None, self.ag_off, self.ag_pos, self.ag_r, rows=mine
-        )
+        wall, obstacle, agent, rob = self.contact_stage.test(self, mine, 1)
         self._merge_flags(mine, wall, obstacle, agent, rob)
         # every robot of the world sees the moved one: all its sensors scan afresh
         self.sensor_stage.scan(self, self.sensor_world == w)

@@ -10,6 +10,7 @@ out, so a caller may keep them).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from functools import partial
 from typing import TYPE_CHECKING, Protocol
 
@@ -116,7 +117,20 @@ class ContactStage:
     """
 
     def reset_worlds(self, engine: Engine, worlds: list[int]) -> None:
-        """Nothing to do: the engine tests the contacts of reset worlds itself."""
+        """Nothing to do: the engine tests the contacts of reset worlds through :meth:`test`."""
+
+    def test(
+        self, engine: Engine, rows: NDArray[np.bool_], worlds: int
+    ) -> tuple[NDArray[np.bool_], I64, I64, I64]:
+        """Contacts of robot rows ``rows`` ``(R,)`` (of ``worlds`` worlds) at their poses now.
+
+        No sweep, no response: what a reset or a teleport reports. Returns ``(wall, obstacle,
+        agent, robot)`` ``(R,)`` each, the rows outside ``rows`` without contact.
+        """
+        return engine.in_pool(worlds, lambda parallel: engine.contacts.test(
+            engine.poses, None, engine.ag_off, engine.ag_pos, engine.ag_r, rows=rows,
+            parallel=parallel,
+        ))
 
     def step(self, engine: Engine, commands: F64, dt: float) -> None:
         """Test, respond, and commit the new robot state."""
@@ -181,9 +195,14 @@ class SensorStage:
     is row ``engine.sensor_local[s]`` of the bank of type ``engine.sensor_kind[s]``. Noise is
     added per world from that world's sensor stream, per due row in sensor-row order (a lidar
     draws one ``(1, beams)`` normal per scan with ``noise_std > 0``, as ``Lidar2D.scan`` does).
+
+    Args:
+        banks: ``kind -> new bank`` (default: the bank class registered in ``SENSORS``); a
+            simulator with banks of its own (MuJoCo) passes its factory.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, banks: Callable[[str], SensorBank] | None = None) -> None:
+        self._make_bank = banks or _registered_bank
         self._scene = SceneBuilder()
         self.banks: dict[str, SensorBank] = {}
         self._bank_rows: dict[str, int] = {}
@@ -193,7 +212,7 @@ class SensorStage:
         """The bank of sensor type ``kind``, built and bound to every loaded world if new."""
         bank = self.banks.get(kind)
         if bank is None:
-            bank = SENSORS.get(kind)()
+            bank = self._make_bank(kind)
             for w, world in enumerate(engine.static_worlds):
                 if world is not None:
                     bank.bind_world(w, world.grid, world.segments_a, world.segments_b)
@@ -301,6 +320,12 @@ class SensorStage:
             reading.flags.writeable = False  # shared by the snapshots: never written
             scans[s] = reading
         engine.scans = scans
+
+
+def _registered_bank(kind: str) -> SensorBank:
+    """A new bank of the sensor type registered as ``kind`` (the default bank factory)."""
+    bank: SensorBank = SENSORS.get(kind)()
+    return bank
 
 
 def _scan(

@@ -16,6 +16,9 @@ from numpy.typing import ArrayLike, NDArray
 from arena.crowd.state import AgentType
 from arena.sim.mujoco.scene import Body, Geom
 
+HIP_FRACTION = 0.53
+"""Hip joint height as a fraction of the stature."""
+
 
 @dataclass(frozen=True)
 class FigureSize:
@@ -31,7 +34,7 @@ class FigureSize:
     @property
     def hip(self) -> float:
         """Hip joint height (m): about 0.53 of the stature."""
-        return 0.53 * self.height
+        return HIP_FRACTION * self.height
 
     @property
     def head_radius(self) -> float:
@@ -57,6 +60,17 @@ HIP_HALF_WIDTH = 0.09
 def figure_size(kind: int) -> FigureSize:
     """The size of a person of type ``kind`` (adults for codes without a size of their own)."""
     return SIZES.get(int(kind), SIZES[AgentType.ADULT])
+
+
+_CODES = np.array(sorted(SIZES), dtype=np.int64)
+_HEIGHTS = np.array([SIZES[int(k)].height for k in _CODES])
+
+
+def statures(kinds: ArrayLike) -> NDArray[np.float64]:
+    """``(n,)`` m, the height of each person type code (:func:`figure_size`, vectorised)."""
+    k = np.asarray(kinds, dtype=np.int64).reshape(-1)
+    at = np.searchsorted(_CODES, k).clip(0, len(_CODES) - 1)
+    return np.where(_CODES[at] == k, _HEIGHTS[at], SIZES[AgentType.ADULT].height)
 
 
 def figure_bodies(person_id: int, kind: int, x: float, y: float, heading: float) -> list[Body]:
@@ -101,7 +115,7 @@ def leg_swing(distance: ArrayLike, speed: ArrayLike, kinds: ArrayLike) -> NDArra
     """
     d = np.asarray(distance, dtype=np.float64)
     v = np.abs(np.asarray(speed, dtype=np.float64))
-    height = np.array([figure_size(k).height for k in np.asarray(kinds).reshape(-1)])
+    height = statures(kinds)
     phase = 2.0 * np.pi * d / (0.8 * height)
     return np.minimum(SWING_PER_SPEED * v, MAX_SWING) * np.sin(phase)
 
@@ -132,7 +146,7 @@ def pose_figures(positions: ArrayLike, headings: ArrayLike, distance: ArrayLike,
     yaw = np.asarray(headings, dtype=np.float64).reshape(-1)
     kinds = np.asarray(kinds).reshape(-1)
     n = p.shape[0]
-    hip = np.array([figure_size(k).hip for k in kinds])
+    hip = HIP_FRACTION * statures(kinds)
     swing = leg_swing(distance, speed, kinds)
     pos = np.zeros((n, 3, 3))
     pos[:, 0, :2] = p

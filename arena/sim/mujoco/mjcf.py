@@ -41,6 +41,8 @@ def _body(parent: ET.Element, body: Body) -> None:
     if body.mocap:
         attrs["mocap"] = "true"
     el = ET.SubElement(parent, "body", attrs)
+    if body.free:
+        ET.SubElement(el, "freejoint", {"name": f"{body.name}/free"})
     for g in body.geoms:
         ET.SubElement(el, "geom", {"name": g.name, "type": g.type, "size": _num(*g.size),
                                    "pos": _num(*g.pos), "material": g.material})

@@ -82,8 +82,10 @@ class Geom:
 class Body:
     """A rigid body: ``kind`` is ``wall``, ``obstacle``, ``robot``, ``person`` or ``person_leg``.
 
-    ``mocap`` bodies are placed by the simulator each step (robots, people); ``person_id`` is the
-    pedestrian id for per-pixel segmentation (``-1`` for anything else).
+    ``mocap`` bodies are placed by the simulator each step (robots, people); ``free`` bodies
+    have a free joint instead (the simulator backend's robots: MuJoCo reports contacts between
+    them and static or mocap bodies, never between two bodies without degrees of freedom);
+    ``person_id`` is the pedestrian id for per-pixel segmentation (``-1`` for anything else).
     """
 
     name: str
@@ -93,6 +95,7 @@ class Body:
     geoms: tuple[Geom, ...]
     mocap: bool = False
     person_id: int = -1
+    free: bool = False
 
 
 @dataclass(frozen=True)

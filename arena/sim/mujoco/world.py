@@ -87,21 +87,27 @@ def obstacle_body(obstacle: Obstacle) -> Body:
     return Body(name, "obstacle", (x, y, 0.0), yaw, geoms)
 
 
+def robot_height(model: RobotModel) -> float:
+    """The model's body height (m), or a one-line :class:`ConfigError` when it has none."""
+    if model.height is None:
+        raise ConfigError(
+            f"robot model {model.name!r}: field 'height' is not set, expected the body height "
+            "in metres (add height: to the robot's YAML) to place it in a 3-D world"
+        )
+    return float(model.height)
+
+
 def robot_body(name: str, model: RobotModel, pose: ArrayLike) -> Body:
     """The mocap body ``robot/<name>``: the footprint extruded to the model's height.
 
     Raises:
         ConfigError: the model has no height, or a footprint other than a circle or rectangle.
     """
-    if model.height is None:
-        raise ConfigError(
-            f"robot model {model.name!r}: field 'height' is not set, expected the body height "
-            "in metres (add height: to the robot's YAML) to place it in a 3-D world"
-        )
+    height = robot_height(model)
     poly = model.footprint_polygon()
     gname = f"robot/{name}/body"
     if poly is None:
-        geom = cylinder(gname, 0.0, 0.0, model.circumscribed_radius, 0.0, model.height, "robot")
+        geom = cylinder(gname, 0.0, 0.0, model.circumscribed_radius, 0.0, height, "robot")
     else:
         x0, y0 = poly.min(axis=0)
         x1, y1 = poly.max(axis=0)
@@ -111,7 +117,7 @@ def robot_body(name: str, model: RobotModel, pose: ArrayLike) -> Body:
                 f"robot model {model.name!r}: field 'footprint' is a polygon that is not an "
                 "axis-aligned rectangle; 3-D worlds expected a circle or a rectangle"
             )
-        geom = box(gname, float(x0), float(x1), float(y0), float(y1), 0.0, model.height, "robot")
+        geom = box(gname, float(x0), float(x1), float(y0), float(y1), 0.0, height, "robot")
     x, y, yaw = (float(v) for v in np.asarray(pose, dtype=np.float64).reshape(3))
     return Body(f"robot/{name}", "robot", (x, y, 0.0), yaw, (geom,), mocap=True)
 
