@@ -111,7 +111,8 @@ def test_ray_gives_the_process_results(reference: pa.Table, contest: Path,
     assert _summary(t) == _summary(reference)
     assert ray.is_initialized()  # not ours to shut down
     assert set(read_manifest(run)) == {"suite", "contest", "seed", "scale", "worlds",
-                                       "created", "arena_version"}  # nothing backend-specific
+                                       "simulator", "created", "arena_version"}
+    # nothing specific to the ray or process pool
 
 
 class _Stop(Exception):
