@@ -27,7 +27,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from pydantic import BaseModel
 
 from arena.core.registry import Registry
@@ -73,12 +73,31 @@ class SensorBank(Protocol):
         """
         ...
 
-    def read(self, s: int, rng: np.random.Generator | None) -> NDArray[np.float64]:
-        """Row ``s``'s latest reading as a new array, its noise drawn from ``rng``.
+    def read(self, s: int, rng: np.random.Generator | None) -> Any:
+        """Row ``s``'s latest reading, new arrays, its noise drawn from ``rng``.
+
+        A reading is an array (``lidar2d``: ``(beams,)`` ranges) or a frozen dataclass of
+        arrays (``rgbd``: :class:`~arena.sensors.spec3d.RgbdFrame`); the engine makes its arrays
+        read-only (:func:`freeze_reading`).
 
         ``rng`` ``None``: without noise (the reading of a row before its first scan).
         """
         ...
+
+
+def freeze_reading(reading: Any) -> Any:
+    """``reading`` with its arrays made read-only (the engine shares readings with snapshots).
+
+    A reading is an array (a lidar's ranges) or a frozen dataclass of arrays (an RGB-D frame);
+    returns ``reading`` itself.
+    """
+    if isinstance(reading, np.ndarray):
+        reading.flags.writeable = False
+    else:
+        for value in vars(reading).values():
+            if isinstance(value, np.ndarray):
+                value.flags.writeable = False
+    return reading
 
 
 SENSORS: Registry[SensorBank] = Registry(

@@ -2,15 +2,17 @@
 
 The ``Params`` of the ``rgbd`` and ``lidar3d`` sensor types
 (:data:`arena.sensors.base.SENSORS`); the MuJoCo backend measures them
-(:mod:`arena.sim.mujoco.camera`, :mod:`arena.sim.mujoco.lidar3d`). Frames: the robot base frame
-is x forward, y left, z up from the floor under the robot's origin (m); a mount's yaw turns
-about z (rad, counter-clockwise), a camera's pitch tilts its optical axis down (rad, positive
-looks at the floor, as ROS's rotation about y).
+(:mod:`arena.sim.mujoco.camera`, :mod:`arena.sim.mujoco.lidar3d`); an ``rgbd`` reading is an
+:class:`RgbdFrame`, a ``lidar3d`` reading a ``(rings, num_beams)`` array of ranges (m).
+Frames: the robot base frame is x forward, y left, z up from the floor under the robot's
+origin (m); a mount's yaw turns about z (rad, counter-clockwise), a camera's pitch tilts its
+optical axis down (rad, positive looks at the floor, as ROS's rotation about y).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -169,3 +171,20 @@ class Lidar3DSpec(BaseModel):
         az = self.angles()[None, :]
         return np.stack(np.broadcast_arrays(np.cos(el) * np.cos(az), np.cos(el) * np.sin(az),
                                             np.sin(el)), axis=-1)
+
+
+@dataclass(frozen=True, eq=False)
+class RgbdFrame:
+    """One camera frame in image order (row 0 at the top, column 0 at the left).
+
+    Attributes:
+        rgb: ``(H, W, 3)`` uint8 colour.
+        depth: ``(H, W)`` float32 metres along the optical axis; ``0`` where no surface lies
+            between the spec's ``near`` and ``far``.
+        person: ``(H, W)`` int32 person id seen at each pixel, ``-1`` for anything else;
+            ``None`` when the camera renders without segmentation.
+    """
+
+    rgb: NDArray[np.uint8]
+    depth: NDArray[np.float32]
+    person: NDArray[np.int32] | None

@@ -43,7 +43,7 @@ from arena.robots.kinematics.base import Kinematics
 from arena.robots.model import RobotModel
 from arena.scene.episode import Episode
 from arena.scene.state import AgentStates, Collisions, RobotStates, SimState, StaticWorld
-from arena.sensors.base import SensorBank
+from arena.sensors.base import SensorBank, freeze_reading
 from arena.sim.backend import PedestrianDriver, split_rng
 from arena.sim.contacts import ContactBank, Footprint
 from arena.sim.engine.agents import PaddedAgents, pad_agents, standing_agents
@@ -359,7 +359,7 @@ class Engine:
         )
         for s, reading in enumerate(s_scans):
             if reading is _NO_READING:  # a fresh row: what its bank reads before a scan
-                s_scans[s] = _frozen(self.sensor_bank[s].read(self.sensor_local[s], None))
+                s_scans[s] = freeze_reading(self.sensor_bank[s].read(self.sensor_local[s], None))
         self.scans = s_scans
 
     def _footprint(self, polygon: F64 | None, radius: float) -> Footprint:
@@ -594,12 +594,6 @@ class Engine:
         if self._padded is None:
             self._padded = pad_agents(self.agents, self.ag_off, self.ag_pos, self.ag_r)
         return self._padded
-
-def _frozen(a: F64) -> F64:
-    """``a`` made read-only (readings are shared by snapshots and their keys)."""
-    a.flags.writeable = False
-    return a
-
 
 def _no_flags(n: int) -> tuple[B1, I64, I64, I64]:
     neg = np.full(n, -1, dtype=np.int64)

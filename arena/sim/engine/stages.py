@@ -22,7 +22,7 @@ from pydantic import BaseModel
 from arena.core.errors import SimulationError
 from arena.robots.kinematics.base import Kinematics, KinematicState, box_step_rows
 from arena.scene.state import StaticWorld
-from arena.sensors.base import SENSORS, SensorBank
+from arena.sensors.base import SENSORS, SensorBank, freeze_reading
 from arena.sim.engine.scene import DynamicScene, SceneBuilder, pedestrian_circles
 
 if TYPE_CHECKING:
@@ -317,7 +317,11 @@ class SensorStage:
             w = world_of[s]
             last[s] = times[w]
             reading = row_bank[s].read(local[s], rngs[w])
-            reading.flags.writeable = False  # shared by the snapshots: never written
+            # shared by the snapshots: never written (a lidar's array inline: the usual case)
+            if type(reading) is np.ndarray:
+                reading.flags.writeable = False
+            else:
+                freeze_reading(reading)
             scans[s] = reading
         engine.scans = scans
 

@@ -23,32 +23,14 @@ Frames carry no noise; :func:`add_depth_noise` adds the spec's from a given gene
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from arena.sensors.spec3d import RgbdSpec
+from arena.sensors.spec3d import RgbdFrame, RgbdSpec
 from arena.sim.mujoco.gl import open_context
 from arena.sim.mujoco.mjcf import import_mujoco, person_ids_by_geom
-
-
-@dataclass(frozen=True, eq=False)
-class RgbdFrame:
-    """One camera frame in image order (row 0 at the top, column 0 at the left).
-
-    Attributes:
-        rgb: ``(H, W, 3)`` uint8 colour.
-        depth: ``(H, W)`` float32 metres along the optical axis; ``0`` where no surface lies
-            between the spec's ``near`` and ``far``.
-        person: ``(H, W)`` int32 person id seen at each pixel, ``-1`` for anything else;
-            ``None`` when the camera renders without segmentation.
-    """
-
-    rgb: NDArray[np.uint8]
-    depth: NDArray[np.float32]
-    person: NDArray[np.int32] | None
 
 
 def camera_pose(

@@ -40,6 +40,8 @@ if TYPE_CHECKING:
 
 MUJOCO_BANKS: dict[str, str] = {
     "lidar2d": "arena.sim.mujoco.lidar2d:MujocoLidar2DBank",
+    "rgbd": "arena.sim.mujoco.banks3d:MujocoRgbdBank",
+    "lidar3d": "arena.sim.mujoco.banks3d:MujocoLidar3DBank",
 }
 """Sensor type -> ``"module:Class"`` of its MuJoCo bank (imported when a robot carries it)."""
 
