@@ -146,6 +146,12 @@ class BatchedSocialNavEnv(VectorEnv[Any, Any, Any]):
         self.dt = float(self.cfg.sim.dt)
         self.substeps = substeps(self.env_cfg, self.dt)
         self.period = self.dt * self.substeps
+        if self.env_cfg.observation.camera.sensor is not None:
+            raise ConfigError(
+                "learning.env.observation.camera: the batched env runs the native2d engine, "
+                "which renders no camera; observe a camera with SocialNavEnv on "
+                "sim.backend.type: mujoco"
+            )
         self.obs_builder = ObservationBuilder(self.env_cfg.observation, self.robot)
         self.decoder = ActionDecoder(self.env_cfg.action, self.robot)
         self.reward_fn = RewardFunction(self.env_cfg.reward)

@@ -87,6 +87,19 @@ class SubgoalObsConfig(_Strict):
     )
 
 
+class CameraObsConfig(_Strict):
+    """Images of one of the robot's ``rgbd`` cameras (the MuJoCo backend renders them)."""
+
+    sensor: str | None = Field(
+        None, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$",
+        description="the robot's rgbd sensor observed; null: no camera part",
+    )
+    channels: tuple[Literal["depth", "rgb"], ...] = Field(
+        ("depth",), min_length=1,
+        description="'depth': (H, W) float32 m (0: no return); 'rgb': (H, W, 3) uint8",
+    )
+
+
 class ObservationConfig(_Strict):
     """Which observation parts the environment returns."""
 
@@ -109,6 +122,7 @@ class ObservationConfig(_Strict):
     pedestrians: PedestrianObsConfig = Field(default_factory=PedestrianObsConfig)
     semantic: SemanticObsConfig = Field(default_factory=SemanticObsConfig)
     subgoal: SubgoalObsConfig = Field(default_factory=SubgoalObsConfig)
+    camera: CameraObsConfig = Field(default_factory=CameraObsConfig)
     flatten: bool = Field(False, description="one flat float32 Box instead of a Dict space")
 
 

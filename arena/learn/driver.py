@@ -227,10 +227,12 @@ class EpisodeDriver:
         pos, vel, kind, st, mask = self._peds() if peds is None else peds
         rs = self.state.robots
         goals = self.goals[:, :2] if self.subgoals is None else self.subgoals.current
+        cam = self.env_cfg.observation.camera.sensor
         return ObsInput(
             poses=rs.poses, twists=rs.twists, goals=goals, scans=self.scans,
             last_action=self.last_action, ped_pos=pos, ped_vel=vel, ped_kind=kind,
             ped_state=st, ped_mask=mask,
+            frames=() if cam is None else tuple(s[cam] for s in rs.sensors),
         )
 
     def goal_distance(self) -> FloatArray:

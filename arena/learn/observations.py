@@ -27,30 +27,38 @@ them with a leading ``N`` axis):
                                        robot, row ↔ robot-frame y, column ↔ x; cell
                                        ``floor(x / roi · size) + size / 2`` (Arena truncates
                                        with ``int``, which doubles the centre cells)
+``depth``          ``(H, W)``          float32 depth (m along the optical axis, ``0`` where
+                                       nothing lies within ``far``) of the ``rgbd`` sensor
+                                       ``camera.sensor``, image order (row 0 at the top)
+``rgb``            ``(H, W, 3)``       uint8 colour of the same camera
 ================== =================== =======================================================
 
 Semantic channels: ``pedestrian_location`` 1, ``pedestrian_type`` the type code,
 ``pedestrian_vel_x``/``_vel_y`` the person's velocity in the robot frame (m/s; Arena writes the
 world-frame force), ``pedestrian_social_state`` Arena's animation code (``evidence >> 8``,
 1 idle … 6 phone). With ``flatten`` the parts are concatenated in the order above into one
-float32 vector.
+float32 vector (not with camera images: they keep the Dict space, for image encoders).
+Camera parts need a backend that renders the ``rgbd`` sensor (``sim.backend.type: mujoco``).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from gymnasium import spaces
 from numpy.typing import NDArray
 
+from arena.core.errors import ConfigError
 from arena.crowd.semantic import decode_animation, encode_social_state, pedestrian_type_codes
 from arena.learn.config import ObservationConfig
 from arena.robots.model import RobotModel
+from arena.sensors.spec3d import RgbdFrame, RgbdSpec
 
 FloatArray = NDArray[np.float64]
-Obs = dict[str, NDArray[np.float32]]
+Obs = dict[str, NDArray[Any]]
 
 PED_FEATURES = ("x", "y", "vx", "vy", "type", "social_state")
 """Columns of the ``pedestrians`` observation."""
@@ -83,6 +91,7 @@ class ObsInput:
         ped_kind: ``(N, M)`` type codes (0 adult, 1 elder, 2 child).
         ped_state: ``(N, M)`` social-state codes.
         ped_mask: ``(N, M)`` bool, the slot holds a person.
+        frames: per world the observed camera's latest frame (``()`` without a camera part).
     """
 
     poses: FloatArray
@@ -95,6 +104,7 @@ class ObsInput:
     ped_kind: NDArray[np.int64]
     ped_state: NDArray[np.int64]
     ped_mask: NDArray[np.bool_]
+    frames: tuple[RgbdFrame, ...] = ()
 
 
 def goal_polar(poses: FloatArray, goals: FloatArray) -> FloatArray:
@@ -219,6 +229,7 @@ class ObservationBuilder:
                 np.broadcast_to(hi[:, None, None], shape).copy(),
                 dtype=np.float32,
             )
+        self.camera_spec = self._camera_parts(config, robot, parts)
         if not parts:
             raise ValueError("the observation is empty: enable at least one part")
         self.dict_space = spaces.Dict(parts)
@@ -245,6 +256,32 @@ class ObservationBuilder:
         self.space: spaces.Space[object] = (
             spaces.flatten_space(self.dict_space) if config.flatten else self.dict_space
         )
+
+    @staticmethod
+    def _camera_parts(
+        config: ObservationConfig, robot: RobotModel, parts: dict[str, spaces.Box]
+    ) -> RgbdSpec | None:
+        """Add the ``depth``/``rgb`` parts of ``config.camera``; its sensor's spec (or None)."""
+        cam = config.camera
+        if cam.sensor is None:
+            return None
+        where = "learning.env.observation.camera.sensor"
+        spec = robot.sensors.get(cam.sensor)
+        if not isinstance(spec, RgbdSpec):
+            cameras = sorted(n for n, s in robot.sensors.items() if isinstance(s, RgbdSpec))
+            raise ConfigError(
+                f"{where}: robot {robot.name!r} has no rgbd sensor {cam.sensor!r}; expected one "
+                f"of its cameras: {', '.join(cameras) or 'none (add one under sensors:)'}"
+            )
+        if config.flatten:
+            raise ConfigError("learning.env.observation.flatten: camera images need the Dict "
+                              "observation (flatten: false), for an image encoder")
+        h, w = spec.height, spec.width
+        if "depth" in cam.channels:
+            parts["depth"] = spaces.Box(0.0, spec.far, (h, w), np.float32)
+        if "rgb" in cam.channels:
+            parts["rgb"] = spaces.Box(0, 255, (h, w, 3), np.uint8)
+        return spec
 
     def build(self, inp: ObsInput) -> Obs:
         """The observation dict with a leading ``N`` axis."""
@@ -280,6 +317,13 @@ class ObservationBuilder:
                 out.update(self._pedestrians(inp, rel, n))
             if cfg.semantic.enabled:
                 out["semantic"] = self._semantic(inp, rel, n)
+        if self.camera_spec is not None:
+            if len(inp.frames) != n:
+                raise ValueError(f"a camera observation needs {n} frames, got {len(inp.frames)}")
+            if "depth" in cfg.camera.channels:
+                out["depth"] = np.stack([f.depth for f in inp.frames])
+            if "rgb" in cfg.camera.channels:
+                out["rgb"] = np.stack([f.rgb for f in inp.frames])
         return out
 
     def _goal_single(self, poses: FloatArray, goals: FloatArray) -> tuple[float, float]:

@@ -29,7 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from arena.sensors.spec3d import RgbdFrame, RgbdSpec
-from arena.sim.mujoco.gl import open_context
+from arena.sim.mujoco.gl import gl_error, open_context
 from arena.sim.mujoco.mjcf import import_mujoco, person_ids_by_geom
 
 
@@ -83,7 +83,10 @@ class RgbdCamera:
         quality.offsamples = 0
         try:
             self._gl = open_context(mj, glob.offwidth, glob.offheight)
-            self._ctx = mj.MjrContext(model, mj.mjtFontScale.mjFONTSCALE_100)
+            try:  # GLFW without a display "opens" a context and fails here
+                self._ctx = mj.MjrContext(model, mj.mjtFontScale.mjFONTSCALE_100)
+            except Exception as e:
+                raise gl_error(e) from None
         finally:
             glob.offwidth, glob.offheight, quality.offsamples = saved
         self._scene = mj.MjvScene(model, maxgeom=max(1000, 2 * model.ngeom))

@@ -50,7 +50,6 @@ def open_context(mujoco: Any, width: int, height: int) -> Any:
     Raises:
         ConfigError: no working OpenGL (missing libraries, no device, a bad ``MUJOCO_GL``).
     """
-    backend = os.environ.get("MUJOCO_GL", "")
     try:
         cls = getattr(mujoco, "GLContext", None)
         if cls is None:
@@ -58,9 +57,25 @@ def open_context(mujoco: Any, width: int, height: int) -> Any:
         ctx = cls(width, height)
         ctx.make_current()
     except Exception as e:  # GL fails in many ways (ImportError, OSError, RuntimeError, GLError)
-        first = (str(e).strip().splitlines() or [type(e).__name__])[0]
-        raise ConfigError(
-            f"no working OpenGL for MuJoCo's offscreen rendering (MUJOCO_GL={backend!r}: "
-            f"{first}); {INSTALL_HINT}"
-        ) from None
+        raise gl_error(e) from None
     return ctx
+
+
+def gl_error(cause: BaseException) -> ConfigError:
+    """The one-line error for a failed offscreen GL context (``cause``: what failed).
+
+    Names the ``MUJOCO_GL`` in use and what to install; without ``MUJOCO_GL`` and without a
+    display MuJoCo fell back to GLFW, which happens when it was imported before
+    :func:`~arena.sim.mujoco.mjcf.import_mujoco` could choose a headless GL.
+    """
+    backend = os.environ.get("MUJOCO_GL", "")
+    first = (str(cause).strip().splitlines() or [type(cause).__name__])[0]
+    hint = INSTALL_HINT
+    if not backend and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        hint = ("mujoco was imported before arena chose a headless GL and uses GLFW, which "
+                "needs a display: set MUJOCO_GL=egl (or osmesa) before importing it; "
+                + INSTALL_HINT)
+    return ConfigError(
+        f"no working OpenGL for MuJoCo's offscreen rendering (MUJOCO_GL={backend!r}: "
+        f"{first}); {hint}"
+    )

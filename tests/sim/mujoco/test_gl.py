@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import pytest
 
 from arena.core.errors import ConfigError
-from arena.sim.mujoco.gl import INSTALL_HINT, choose_gl, open_context
+from arena.sim.mujoco.gl import INSTALL_HINT, choose_gl, gl_error, open_context
 
 
 def libs(*found: str):
@@ -55,3 +55,15 @@ def test_open_context_failure_is_one_line_with_what_to_install(monkeypatch):
         open_context(SimpleNamespace(GLContext=Broken), 1, 1)  # its first line only
     ctx = open_context(SimpleNamespace(GLContext=Fine), 320, 240)
     assert ctx.size == (320, 240) and ctx.current
+
+
+def test_glfw_without_a_display_says_to_set_mujoco_gl(monkeypatch):
+    # mujoco imported before arena: no MUJOCO_GL, no display -> GLFW, which cannot work here
+    for var in ("MUJOCO_GL", "DISPLAY", "WAYLAND_DISPLAY"):
+        monkeypatch.delenv(var, raising=False)
+    msg = str(gl_error(RuntimeError("an OpenGL platform library has not been loaded\nmore")))
+    assert "\n" not in msg
+    assert "MUJOCO_GL='': an OpenGL platform library has not been loaded);" in msg
+    assert "set MUJOCO_GL=egl (or osmesa) before importing it" in msg and INSTALL_HINT in msg
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    assert "before importing it" not in str(gl_error(RuntimeError("x")))
