@@ -41,6 +41,7 @@ from arena.sensors.lidar2d.model import (
     _points,
     beam_tables,
     cell_distances,
+    polygon_sides,
     use_wall_faces,
     wall_faces,
 )
@@ -167,7 +168,6 @@ class _MapSlot:
     worlds: int = 0  # worlds showing it now
 
 
-_EMPTY_OWNER = np.zeros(0, dtype=np.int64)
 
 
 @SENSORS.register("lidar2d")
@@ -185,7 +185,7 @@ class LidarBank:
     def __init__(self) -> None:
         self._dist = _Blocks(((), np.float32))
         self._faces = _Blocks(((4,), np.float64))
-        self._segs = _Blocks(((2,), np.float64), ((2,), np.float64))
+        self._segs = _Blocks(((2,), np.float64), ((2,), np.float64), ((), np.float64))
         self._slots: dict[int, _MapSlot] = {}  # by id(grid); the slot holds the grid
         self._free_index: list[int] = []
         self._map_i = np.zeros((0, 5), dtype=np.int64)
@@ -257,7 +257,7 @@ class LidarBank:
             if not self._segs.room(len(a)):
                 self._segs.compact(len(a))
                 self._refresh_segments()
-            self._world_seg[w] = self._segs.add(a, b)
+            self._world_seg[w] = self._segs.add(a, b, polygon_sides(a, b))
         self._world_i[w] = (slot.index, *self._segment_span(w))
 
     def _segment_span(self, w: int) -> tuple[int, int]:
@@ -487,7 +487,7 @@ class LidarBank:
             self._row_robot, self._row_world, self._row_spec, self._out_off,
             self._beam_off, self._cos, self._sin, self._spec_f,
             self._map_i, self._map_f, self._dist.data[0], self._faces.data[0], self._use_faces,
-            self._world_i, self._segs.data[0], self._segs.data[1], _EMPTY_OWNER,
+            self._world_i, self._segs.data[0], self._segs.data[1], self._segs.data[2],
         )
         return head, (self._scratch_f, self._scratch_i, self._out)
 

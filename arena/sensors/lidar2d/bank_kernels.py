@@ -19,7 +19,8 @@ Tables (built by :class:`~arena.sensors.lidar2d.bank.LidarBank`, all C-contiguou
   and ``faces`` ``(F, 4)``; ``map_f`` ``(G, 3)`` ``[resolution m, origin x m, origin y m]``;
   ``use_faces`` ``(G, K)``: cast the walls of map ``g`` as faces for spec ``k``;
 * worlds ``(W, 3)`` ``world_i``: ``[map slot, static segment offset, static segment count]``
-  into ``stat_a``/``stat_b`` ``(P, 2)``;
+  into ``stat_a``/``stat_b`` ``(P, 2)`` and their back-face sides ``stat_side`` ``(P,)``
+  (:func:`~arena.sensors.lidar2d.model.polygon_sides`);
 * the dynamic scene (``circ_*``, ``seg_*``), per world by ``circ_off``/``seg_off``, owners being
   global robot rows.
 """
@@ -50,7 +51,7 @@ def _scan_row(
     s: int, poses: F64, row_robot: I64, row_world: I64, row_spec: I64, out_off: I64,
     beam_off: I64, cos_all: F64, sin_all: F64, spec_f: F64,
     map_i: I64, map_f: F64, dist: F32, faces: F64, use_faces: B1,
-    world_i: I64, stat_a: F64, stat_b: F64, no_owner: I64,
+    world_i: I64, stat_a: F64, stat_b: F64, stat_side: F64,
     circ_off: I64, circ_xy: F64, circ_r: F64, circ_owner: I64,
     seg_off: I64, seg_a: F64, seg_b: F64, seg_owner: I64,
     scratch_f: F64, scratch_i: I64, out: F64,
@@ -92,7 +93,7 @@ def _scan_row(
         spec_f[k, 5], spec_f[k, 6],
         dist[d0 : d0 + h * wd].reshape((h, wd)), map_f[g, 0], map_f[g, 1], map_f[g, 2],
         faces[f0 : f0 + map_i[g, 4]], use_faces[g, k],
-        stat_a[p0:p1], stat_b[p0:p1], no_owner,
+        stat_a[p0:p1], stat_b[p0:p1], stat_side[p0:p1],
         circ_xy[c0:c1], circ_r[c0:c1], circ_owner[c0:c1],
         seg_a[e0:e1], seg_b[e0:e1], seg_owner[e0:e1], r,
         scratch_f, scratch_i, out[out_off[s] : out_off[s + 1]],
@@ -105,7 +106,7 @@ def scan_rows(
     rows: I64, poses: F64, row_robot: I64, row_world: I64, row_spec: I64, out_off: I64,
     beam_off: I64, cos_all: F64, sin_all: F64, spec_f: F64,
     map_i: I64, map_f: F64, dist: F32, faces: F64, use_faces: B1,
-    world_i: I64, stat_a: F64, stat_b: F64, no_owner: I64,
+    world_i: I64, stat_a: F64, stat_b: F64, stat_side: F64,
     circ_off: I64, circ_xy: F64, circ_r: F64, circ_owner: I64,
     seg_off: I64, seg_a: F64, seg_b: F64, seg_owner: I64,
     scratch_f: F64, scratch_i: I64, out: F64,
@@ -120,7 +121,7 @@ def scan_rows(
     for j in range(rows.shape[0]):
         code = _scan_row(
             rows[j], poses, row_robot, row_world, row_spec, out_off, beam_off, cos_all, sin_all,
-            spec_f, map_i, map_f, dist, faces, use_faces, world_i, stat_a, stat_b, no_owner,
+            spec_f, map_i, map_f, dist, faces, use_faces, world_i, stat_a, stat_b, stat_side,
             circ_off, circ_xy, circ_r, circ_owner, seg_off, seg_a, seg_b, seg_owner,
             scratch_f[0], scratch_i[0], out,
         )
@@ -133,7 +134,7 @@ def scan_rows_parallel(
     rows: I64, poses: F64, row_robot: I64, row_world: I64, row_spec: I64, out_off: I64,
     beam_off: I64, cos_all: F64, sin_all: F64, spec_f: F64,
     map_i: I64, map_f: F64, dist: F32, faces: F64, use_faces: B1,
-    world_i: I64, stat_a: F64, stat_b: F64, no_owner: I64,
+    world_i: I64, stat_a: F64, stat_b: F64, stat_side: F64,
     circ_off: I64, circ_xy: F64, circ_r: F64, circ_owner: I64,
     seg_off: I64, seg_a: F64, seg_b: F64, seg_owner: I64,
     scratch_f: F64, scratch_i: I64, out: F64,
@@ -148,7 +149,7 @@ def scan_rows_parallel(
         t = numba.get_thread_id()
         code = _scan_row(
             rows[j], poses, row_robot, row_world, row_spec, out_off, beam_off, cos_all, sin_all,
-            spec_f, map_i, map_f, dist, faces, use_faces, world_i, stat_a, stat_b, no_owner,
+            spec_f, map_i, map_f, dist, faces, use_faces, world_i, stat_a, stat_b, stat_side,
             circ_off, circ_xy, circ_r, circ_owner, seg_off, seg_a, seg_b, seg_owner,
             scratch_f[t], scratch_i[t], out,
         )

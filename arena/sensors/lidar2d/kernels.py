@@ -22,6 +22,8 @@ from arena.sensors.lidar2d.grid_kernels import CORNER_EPS, _cast_grid_many, _ori
 _AXIS_SNAP = 1e-12
 _TWO_PI = 2.0 * math.pi
 
+_NO_SIDE = np.zeros(0)  # no back-face culling (dynamic segments)
+
 #: Rows of the float and int scratch arrays :func:`_scan_one` needs (each ``num_beams`` long).
 SCRATCH_F = 6
 SCRATCH_I = 2
@@ -144,10 +146,19 @@ def _segments_into(
     best: NDArray[np.float64], dx: NDArray[np.float64], dy: NDArray[np.float64],
     ox: float, oy: float, a0: float, inc: float, range_max: float,
     seg_a: NDArray[np.float64], seg_b: NDArray[np.float64], owner: NDArray[np.int64],
-    robot: int,
+    robot: int, side: NDArray[np.float64],
 ) -> None:
-    """Lower ``best`` with the hits on every segment (skipping those owned by ``robot``)."""
+    """Lower ``best`` with the hits on every segment (skipping those owned by ``robot``).
+
+    ``side`` ``(s,)`` (or empty: none) culls back faces: an edge of a closed polygon with
+    ``side[k] = +1`` (counter-clockwise polygon) or ``-1`` (clockwise) is skipped when the
+    origin lies on its polygon's inner side of its line. A beam entering a polygon crosses an
+    edge with the origin on that edge's outer side, so the nearest hit on a polygon seen from
+    outside is always on a front edge; about half the edges need no beam tests (see
+    :func:`~arena.sensors.lidar2d.model.polygon_sides`).
+    """
     n = best.shape[0]
+    culled = side.shape[0] == seg_a.shape[0]
     # Polygon edges chain (b of one edge is a of the next): reuse that end's direction.
     prev_bx = math.nan
     prev_by = math.nan
@@ -161,6 +172,8 @@ def _segments_into(
         by = seg_b[k, 1] - oy
         ex = bx - ax
         ey = by - ay
+        if culled and side[k] * (ey * ax - ex * ay) > 0.0:
+            continue  # back face: the origin is on the polygon's inner side of this edge
         # Bounding-circle prune: the segment lies within half its length of its midpoint.
         mx = 0.5 * (ax + bx)
         my = 0.5 * (ay + by)
@@ -305,7 +318,7 @@ def _scan_one(
     range_min: float, range_max: float,
     distg: NDArray[np.float32], res: float, gx0: float, gy0: float,
     faces: NDArray[np.float64], use_faces: bool,
-    stat_a: NDArray[np.float64], stat_b: NDArray[np.float64], stat_owner: NDArray[np.int64],
+    stat_a: NDArray[np.float64], stat_b: NDArray[np.float64], stat_side: NDArray[np.float64],
     circ_xy: NDArray[np.float64], circ_r: NDArray[np.float64], circ_owner: NDArray[np.int64],
     dyn_a: NDArray[np.float64], dyn_b: NDArray[np.float64], dyn_owner: NDArray[np.int64],
     robot: int, scratch_f: NDArray[np.float64], scratch_i: NDArray[np.int64],
@@ -337,7 +350,8 @@ def _scan_one(
         use_faces: cast the walls as faces instead of walking the grid.
         stat_a: ``(s, 2)`` static segment starts (m).
         stat_b: ``(s, 2)`` static segment ends (m).
-        stat_owner: never read (static segments belong to nobody).
+        stat_side: ``(s,)`` back-face sides of the static segments
+            (:func:`~arena.sensors.lidar2d.model.polygon_sides`), or empty: no culling.
         circ_xy: ``(m, 2)`` circle centres (m).
         circ_r: ``(m,)`` circle radii (m).
         circ_owner: ``(m,)`` owner of each circle (read only if ``robot >= 0``).
@@ -412,8 +426,10 @@ def _scan_one(
             _circle_hit(best, i, dx, dy, ccx, ccy, c2)
 
     # -- segments: static obstacle edges, then dynamic ones --
-    _segments_into(best, dx, dy, ox, oy, a0, inc, range_max, stat_a, stat_b, stat_owner, -1)
-    _segments_into(best, dx, dy, ox, oy, a0, inc, range_max, dyn_a, dyn_b, dyn_owner, robot)
+    _segments_into(best, dx, dy, ox, oy, a0, inc, range_max, stat_a, stat_b, dyn_owner, -1,
+                   stat_side)
+    _segments_into(best, dx, dy, ox, oy, a0, inc, range_max, dyn_a, dyn_b, dyn_owner, robot,
+                   _NO_SIDE)
 
     # -- grid, limited to the nearest hit found so far --
     for i in range(n):
@@ -440,7 +456,7 @@ def _scan_kernel(
     range_min: float, range_max: float,
     distg: NDArray[np.float32], res: float, gx0: float, gy0: float,
     circ_xy: NDArray[np.float64], circ_r: NDArray[np.float64], circ_owner: NDArray[np.int64],
-    stat_a: NDArray[np.float64], stat_b: NDArray[np.float64], stat_owner: NDArray[np.int64],
+    stat_a: NDArray[np.float64], stat_b: NDArray[np.float64], stat_side: NDArray[np.float64],
     dyn_a: NDArray[np.float64], dyn_b: NDArray[np.float64], dyn_owner: NDArray[np.int64],
     use_owner: bool, faces: NDArray[np.float64], use_faces: bool, out: NDArray[np.float64],
 ) -> None:
@@ -464,7 +480,7 @@ def _scan_kernel(
         circ_owner: ``(m,)`` robot owning each circle (read only if ``use_owner``).
         stat_a: ``(s, 2)`` static segment starts (m).
         stat_b: ``(s, 2)`` static segment ends (m).
-        stat_owner: unused placeholder (static segments belong to nobody).
+        stat_side: ``(s,)`` back-face sides of the static segments, or empty: no culling.
         dyn_a: ``(k, 2)`` dynamic segment starts (m).
         dyn_b: ``(k, 2)`` dynamic segment ends (m).
         dyn_owner: ``(k,)`` robot owning each dynamic segment (read only if ``use_owner``).
@@ -479,7 +495,7 @@ def _scan_kernel(
     for r in range(poses.shape[0]):
         _scan_one(
             poses[r], mount, cos_a, sin_a, angle_min, inc, range_min, range_max,
-            distg, res, gx0, gy0, faces, use_faces, stat_a, stat_b, stat_owner,
+            distg, res, gx0, gy0, faces, use_faces, stat_a, stat_b, stat_side,
             circ_xy, circ_r, circ_owner, dyn_a, dyn_b, dyn_owner, r if use_owner else -1,
             scratch_f, scratch_i, out[r],
         )

@@ -24,7 +24,11 @@ A beam is the half-line ``o + t·d`` (``t ≥ 0``, metres) from the sensor origi
   with *every* beam, which reports ``range_min`` (the sensor is covered).
 * a **segment** (static obstacle edges from :meth:`bind`, dynamic ones per scan such as other
   robots' footprints), taken as a thin wall visible from both sides. An origin lying exactly on
-  a segment hits it at ``t = 0`` with every beam.
+  a segment hits it at ``t = 0`` with every beam. Static edges that close a polygon (an
+  obstacle's footprint) are seen from outside only: the edges facing away from the sensor are
+  not tested (:func:`polygon_sides`; the nearest hit is always on a facing edge, so the ranges
+  are unchanged, at about half the cost), and a sensor inside an obstacle's polygon does not
+  see that obstacle.
 
 Ranges are then clipped: no hit before ``range_max`` reports ``range_max``; a hit nearer than
 ``range_min`` reports ``range_min``. A sensor origin that touches a blocking cell (inside it or
@@ -158,6 +162,36 @@ def use_wall_faces(faces: NDArray[np.float64], num_beams: int) -> bool:
     return len(faces) <= FACES_PER_BEAM * max(num_beams, 64)
 
 
+def polygon_sides(a: FloatArray, b: FloatArray) -> FloatArray:
+    """``(s,)`` back-face side of each segment ``a[k] → b[k]`` (m): ``+1``, ``-1`` or ``0``.
+
+    Consecutive segments chained end to start (``b[k] == a[k + 1]``, exactly) that return to
+    their first point form a closed polygon; its edges get ``+1`` when it runs
+    counter-clockwise (shoelace area > 0), ``-1`` when clockwise. Other segments (open chains,
+    degenerate polygons) get ``0``: never culled. A lidar skips an edge whose polygon's inner
+    side holds the sensor (:func:`~arena.sensors.lidar2d.kernels._segments_into`): a beam from
+    outside first meets a polygon on an edge it crosses inwards, whose outer side holds the
+    sensor. So ranges are those of testing every edge, for a sensor outside the polygons (a
+    sensor inside an obstacle's polygon does not see that obstacle).
+    """
+    s = a.shape[0]
+    side = np.zeros(s)
+    linked = np.all(b[:-1] == a[1:], axis=1).tolist() if s > 1 else []
+    start = 0
+    while start < s:
+        end = start  # extend the chain until it closes or breaks
+        while (end + 1 < s and linked[end]
+               and not (b[end, 0] == a[start, 0] and b[end, 1] == a[start, 1])):
+            end += 1
+        closed = b[end, 0] == a[start, 0] and b[end, 1] == a[start, 1]
+        if closed and end - start >= 2:
+            pa, pb = a[start : end + 1], b[start : end + 1]
+            area = float(np.sum(pa[:, 0] * pb[:, 1] - pa[:, 1] * pb[:, 0]))
+            side[start : end + 1] = np.sign(area)
+        start = end + 1
+    return side
+
+
 def cell_distances(grid: OccupancyGrid) -> NDArray[np.float32]:
     """``grid``'s distance map in cells, as the scan kernels read it: ``(H, W)`` float32.
 
@@ -209,6 +243,7 @@ class Lidar2D:
         self._use_faces = False
         self._seg_a = _EMPTY_PTS
         self._seg_b = _EMPTY_PTS
+        self._seg_side = np.zeros(0)
         self._warm_up()
 
     # -- set-up ------------------------------------------------------------------------------------
@@ -245,6 +280,7 @@ class Lidar2D:
             self._use_faces = use_wall_faces(self._faces, self.spec.num_beams)
             self._grid = grid
         self._seg_a, self._seg_b = a, b
+        self._seg_side = polygon_sides(a, b)
 
     # -- scanning ----------------------------------------------------------------------------------
     def scan(
@@ -337,7 +373,7 @@ class Lidar2D:
             q, self._mount, self._cos, self._sin, spec.angle_min, self._inc,
             spec.range_min, spec.range_max,
             self._distg, grid.resolution, grid.origin[0], grid.origin[1],
-            cxy, cr, c_own, self._seg_a, self._seg_b, _EMPTY_OWNER, da, db, d_own,
+            cxy, cr, c_own, self._seg_a, self._seg_b, self._seg_side, da, db, d_own,
             use_owner, self._faces, self._use_faces, out,
         )
         if rng is not None and spec.noise_std > 0.0:
@@ -350,13 +386,14 @@ class Lidar2D:
     def _warm_up(self) -> None:
         """Compile (or load from cache) the kernels with the exact argument types used later."""
         grid, distg, faces, use = self._grid, self._distg, self._faces, self._use_faces
-        a, b = self._seg_a, self._seg_b
+        a, b, side = self._seg_a, self._seg_b, self._seg_side
         self._grid = OccupancyGrid.empty(0.5, 0.5, 0.1)
         self._distg = np.zeros((5, 5), dtype=np.float32)
         self._distg[1:4, 1:4] = 1.0
         self._faces = _compute_faces(self._distg == 0.0).copy()
         self._seg_a = np.array([[0.1, 0.35]])
         self._seg_b = np.array([[0.2, 0.35]])
+        self._seg_side = np.zeros(1)
         try:
             for self._use_faces in (False, True):
                 self.scan_many(
@@ -367,4 +404,4 @@ class Lidar2D:
             _add_noise(np.zeros((1, 1)), np.zeros((1, 1)), 0.0, 0.0, 1.0)
         finally:
             self._grid, self._distg, self._faces, self._use_faces = grid, distg, faces, use
-            self._seg_a, self._seg_b = a, b
+            self._seg_a, self._seg_b, self._seg_side = a, b, side
