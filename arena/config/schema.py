@@ -18,7 +18,7 @@ from arena.core.names import RULE, SafeLabel
 from arena.core.rng import Seed
 from arena.crowd.simulator import PedestrianConfig
 from arena.learn.config import LearningConfig
-from arena.nav.stack import NavigationConfig
+from arena.nav.config import NavigationConfig
 from arena.tasks.config import TaskConfig
 
 

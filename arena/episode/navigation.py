@@ -18,14 +18,16 @@ from arena.core.errors import ArenaError
 from arena.core.types import Outcome, Pose2D
 from arena.episode.runner import EpisodeHooks, EpisodeRunner
 from arena.maps.raster import planning_grid
+from arena.nav.build import stack_from_config
+from arena.nav.config import NavStatus
 from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
-from arena.nav.stack import NavigationStack, NavStatus
+from arena.nav.stack import NavigationStack
 from arena.sensors.spec import LidarReading, LidarSpec, lidar_geometry
 
 if TYPE_CHECKING:
+    from arena.nav.config import NavigationConfig
     from arena.nav.local_planners.base import LocalPlanner
-    from arena.nav.stack import NavigationConfig
     from arena.robots.model import RobotModel
     from arena.scene.episode import Episode
     from arena.tasks.generator import TaskRuntime
@@ -51,7 +53,7 @@ def build_stack(
     yaw = cfg.goal_tolerance_yaw
     if episode.goal_tolerance_angle is not None:
         yaw = float(episode.goal_tolerance_angle)
-    return NavigationStack.from_config(
+    return stack_from_config(
         cfg, robot_radius=robot.radius,
         footprint_radius=robot.inscribed_radius or None,  # narrow passages: the body fits
         local_planner=local_planner,

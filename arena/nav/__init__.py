@@ -4,6 +4,8 @@ The local-planner registry names its built-ins and imports one when a config nam
 :class:`NavigationStack` is the pipeline a task drives every control tick.
 """
 
+from arena.nav.build import stack_from_config
+from arena.nav.config import NavigationConfig, NavStatus
 from arena.nav.global_planners import GLOBAL_PLANNERS, AStarPlanner, GlobalPlanner
 from arena.nav.local_planners import (
     KINEMATICS,
@@ -12,7 +14,7 @@ from arena.nav.local_planners import (
     LocalPlanner,
 )
 from arena.nav.local_planners.pure_pursuit import PurePursuitPlanner
-from arena.nav.stack import NavigationConfig, NavigationStack, NavStatus
+from arena.nav.stack import NavigationStack
 
 __all__ = [
     "GLOBAL_PLANNERS",
@@ -26,4 +28,5 @@ __all__ = [
     "NavigationConfig",
     "NavigationStack",
     "PurePursuitPlanner",
+    "stack_from_config",
 ]

@@ -48,269 +48,53 @@ Policies (documented here because tasks and metrics depend on them):
   (values not overridden return to the configured ones); :meth:`NavigationStack.reset` restores
   the configured parameters.
 
-move_base_flex-like features (all opt-in; with the defaults the stack behaves as before):
-
-- **Rates.** The global planner runs at reset, every ``replan_period`` s, on deviation, and at
-  once when the path ahead is blocked (``replan_on_blocked``); the intermediate planner every
-  ``intermediate_period`` s; the local planner every control tick (``step``).
-- **Global costmap** (``navigation.global_costmap: {...}``). The global plan is made on a
-  :class:`~arena.nav.costmap.GlobalCostmap` of the static map, inflated with inscribed radius
-  ``robot_radius + inflation_margin`` (its lethal/inscribed cells are exactly the inflated map's
-  occupied cells) and a decaying cost out to ``inflation_radius``. With ``cost_weight > 0`` the
-  cost-aware search :func:`~arena.nav.global_planners.plan_on_costmap` plans (keeping clear of
-  walls); with 0 the configured global planner plans on the lethal cells. ``use_scan: true``
-  folds every scan into its obstacle layer (marks persist until raytraced free or cleared).
-- **Local costmap** (``navigation.local_costmap: {...}``): a rolling window updated every tick
-  from the scan (and pedestrians), given to the local planner as ``LocalObservation.costmap``.
-- **Blocked path.** With ``replan_on_blocked`` the next ``blocked_lookahead`` m of path are
-  checked every tick (at most one blocked replan per 0.5 s): a laser return within
-  ``robot_radius`` of the path, or an inscribed/lethal local-costmap cell on it, triggers a
-  replan with the current scan marked on the planning grid (inflated like the map; in the
-  global costmap: folded into its obstacle layer). Periodic replans then keep marking the scan
-  so the path does not flip back. Readings at ``scan_range_max`` count as no return.
-- **Oscillation and recovery.** With ``oscillation_timeout > 0`` a robot that has not moved
-  ``oscillation_distance`` m within that time runs the next of ``recovery_behaviors``
-  (``clear_costmap``, ``rotate``, ``back_up``; see :mod:`arena.nav.recovery`); the status is
-  ``RECOVERING`` during a motion recovery. Once every behaviour has run without the robot
-  getting away, the status becomes ``STUCK`` (commands only brake; the episode ends ``stuck``).
+move_base_flex-like features (all opt-in; with the defaults the stack behaves as before; the
+``navigation`` keys in docs/navigation.md): the global planner runs at reset, every
+``replan_period`` s, on deviation and at once when the path ahead is blocked
+(``replan_on_blocked``, :mod:`arena.nav.planning`); the intermediate planner every
+``intermediate_period`` s; the local planner every control tick. A **global costmap** plans on
+a :class:`~arena.nav.costmap.GlobalCostmap` of the static map (inscribed radius ``robot_radius
++ inflation_margin``; cost-aware search with ``cost_weight > 0``, else the configured planner on
+its lethal cells; ``use_scan`` folds every scan into its obstacle layer); a **local costmap** is
+a rolling window updated every tick and given to the local planner; **oscillation and
+recovery** are :mod:`arena.nav.stuck`'s.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import enum
 import math
-from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
-from scipy import ndimage
+from pydantic import BaseModel
 
-from arena.core.errors import ConfigError, PlanningError, StartOccupied, from_validation_error
+from arena.core.errors import ConfigError, PlanningError
 from arena.core.geometry import point_segment_distance
 from arena.core.types import Pose2D, wrap_angle_scalar
 from arena.maps.grid import OccupancyGrid
-from arena.nav.costmap import (
-    INSCRIBED,
-    Costmap,
-    CostmapParams,
-    GlobalCostmap,
-    LocalCostmap,
-    update_obstacles,
+from arena.nav.config import (
+    DEFAULTS,
+    GlobalCostmapConfig,
+    LocalCostmapConfig,
+    NavStatus,
 )
-from arena.nav.global_planners import (
-    GLOBAL_PLANNERS,
-    GlobalPlanner,
-    plan_on_costmap,
-    segment_is_free,
-)
+from arena.nav.costmap import GlobalCostmap, LocalCostmap
+from arena.nav.global_planners import GlobalPlanner
 from arena.nav.intermediate import (
     INTERMEDIATE_PLANNERS,
     IntermediateInput,
     IntermediatePlanner,
     Pedestrians,
 )
-from arena.nav.local_planners import (
-    LOCAL_PLANNERS,
-    LocalObservation,
-    LocalPlanner,
-    infer_kinematics,
-    limit_command,
-)
-from arena.nav.recovery import (
-    RECOVERY_BEHAVIORS,
-    OscillationMonitor,
-    RecoveryName,
-    RecoveryRun,
-    mark_points,
-    rear_is_free,
-    sample_path,
-    scan_to_world,
-)
+from arena.nav.local_planners import LocalObservation, LocalPlanner, limit_command
+from arena.nav.planning import PathPlanning, subdivide
+from arena.nav.recovery import OscillationMonitor, RecoveryName, RecoveryRun, sample_path
+from arena.nav.stuck import StuckRecovery
 
-
-class NavStatus(enum.StrEnum):
-    """Where a navigation run stands. Values are stable strings."""
-
-    ACTIVE = "active"
-    """Following a path toward the goal."""
-    GOAL_REACHED = "goal_reached"
-    """Within the goal tolerances; commands only brake."""
-    FAILED = "failed"
-    """The initial plan failed; the typed error is in :attr:`NavigationStack.last_error`."""
-    RECOVERING = "recovering"
-    """Running a motion recovery behaviour (rotate, back up) after getting stuck."""
-    STUCK = "stuck"
-    """Stuck and every recovery behaviour has been tried; commands only brake."""
-
-
-def _planner_block(value: Any) -> Any:
-    """Normalise the shorthand ``"name"`` to ``{"type": "name"}``."""
-    return {"type": value} if isinstance(value, str) else value
-
-
-class CostmapConfig(BaseModel):
-    """Layer parameters of a costmap built by the stack (SI units, ``costmap_2d`` defaults).
-
-    The inscribed radius is not configured here: the stack uses ``robot_radius +
-    inflation_margin``, so cells the robot centre may not enter are those of the inflated map.
-    """
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
-    inflation_radius: float | None = Field(
-        None, ge=0, description="m, extent of the cost decay; None = inscribed radius + 0.5 m"
-    )
-    cost_scaling_factor: float = Field(
-        10.0, ge=0, description="1/m, exponential decay rate of the inflation cost"
-    )
-    obstacle_range: float = Field(2.5, gt=0, description="m, returns closer than this mark")
-    raytrace_range: float = Field(3.0, gt=0, description="m, free space cleared up to this range")
-
-    def params(self, inscribed_radius: float, *, use_semantic: bool) -> CostmapParams:
-        """The :class:`CostmapParams` for a robot of ``inscribed_radius`` (m)."""
-        inflation = (
-            inscribed_radius + 0.5 if self.inflation_radius is None else self.inflation_radius
-        )
-        return CostmapParams(
-            inscribed_radius=inscribed_radius,
-            inflation_radius=max(inflation, inscribed_radius),
-            cost_scaling_factor=self.cost_scaling_factor,
-            obstacle_range=self.obstacle_range,
-            raytrace_range=self.raytrace_range,
-            use_semantic=use_semantic,
-        )
-
-
-class GlobalCostmapConfig(CostmapConfig):
-    """The ``navigation.global_costmap`` block: plan on a layered costmap of the static map."""
-
-    use_scan: bool = Field(
-        False, description="fold every laser scan into the obstacle layer (else only on a block)"
-    )
-    cost_weight: float = Field(
-        3.0, ge=0,
-        description="extra cost per metre at cost 252 for the cost-aware search; 0 = plan with "
-        "the configured global planner on the costmap's lethal (inscribed) cells",
-    )
-
-
-class LocalCostmapConfig(CostmapConfig):
-    """The ``navigation.local_costmap`` block: a rolling window updated every control tick."""
-
-    width: float = Field(6.0, gt=0, description="m, window width")
-    height: float = Field(6.0, gt=0, description="m, window height")
-    use_pedestrians: bool = Field(True, description="add the pedestrian (semantic) layer")
-
-
-class NavigationConfig(BaseModel):
-    """The ``navigation`` block of an experiment: which planners, and the stack's policies."""
-
-    model_config = ConfigDict(frozen=True, extra="forbid")
-
-    global_planner: dict[str, Any] = Field(
-        default_factory=lambda: {"type": "astar"},
-        description="global planner block {type: name, **params}",
-    )
-    local_planner: dict[str, Any] = Field(
-        default_factory=lambda: {"type": "pure_pursuit"},
-        description="local planner block {type: name, **params}",
-    )
-    intermediate_planner: dict[str, Any] = Field(
-        default_factory=lambda: {"type": "bypass"},
-        description="intermediate planner block {type: name, **params}",
-    )
-    scan_sensor: str = Field(
-        "laser", pattern=r"^[A-Za-z_][A-Za-z0-9_]*$",
-        description="the robot's lidar2d sensor the stack and its costmaps read",
-    )
-    intermediate_period: float = Field(
-        0.0, ge=0, description="s between intermediate-planner calls; 0 = every control tick"
-    )
-    intermediate_window: float = Field(
-        5.0, gt=0, description="m, radius of the local window given to the intermediate planner"
-    )
-    replan_period: float = Field(1.0, ge=0, description="s between global replans; 0 = never")
-    inflation_margin: float = Field(
-        0.05, ge=0, description="m of clearance added to the robot radius when inflating the map"
-    )
-    planning_resolution: float = Field(
-        0.1, gt=0, description="m; a map with coarser cells is planned on its cells split to at "
-        "most this size, so the inflation is exact to within it"
-    )
-    goal_tolerance_xy: float = Field(0.3, gt=0, description="m, distance that counts as arrived")
-    goal_tolerance_yaw: float | None = Field(
-        None, gt=0, description="rad, heading error that counts as arrived; None ignores heading"
-    )
-    max_path_deviation: float = Field(
-        0.5, gt=0, description="m from the path beyond which the stack replans at once"
-    )
-    global_costmap: GlobalCostmapConfig | None = Field(
-        None, description="plan on a layered global costmap; None = on the inflated map"
-    )
-    local_costmap: LocalCostmapConfig | None = Field(
-        None, description="rolling local costmap given to the local planner; None = none"
-    )
-    replan_on_blocked: bool = Field(
-        False, description="replan at once (with the scan marked) when the path ahead is blocked"
-    )
-    blocked_lookahead: float = Field(
-        2.0, gt=0, description="m of path ahead of the robot checked for blocking"
-    )
-    oscillation_timeout: float = Field(
-        0.0, ge=0, description="s without oscillation_distance of motion that count as stuck; "
-        "0 disables oscillation detection and recovery"
-    )
-    oscillation_distance: float = Field(
-        0.2, gt=0, description="m the robot must move to count as making progress"
-    )
-    recovery_behaviors: tuple[RecoveryName, ...] = Field(
-        RECOVERY_BEHAVIORS, description="recovery behaviours, in order, when stuck"
-    )
-    back_up_distance: float = Field(0.3, gt=0, description="m reversed by the back_up recovery")
-    back_up_speed: float = Field(0.1, gt=0, description="m/s of the back_up recovery")
-    rotate_speed: float = Field(
-        1.0, gt=0, description="rad/s of the rotate recovery (capped by the robot's limit)"
-    )
-
-    # The planner blocks are checked against their registries where the file and key path are
-    # known (the experiment loader, :meth:`NavigationStack.from_config`), not here: a pydantic
-    # error would lose the UnknownNameError type and the exact key path inside the block.
-    @field_validator("global_planner", "local_planner", "intermediate_planner", mode="before")
-    @classmethod
-    def _shorthand(cls, v: Any) -> Any:
-        return _planner_block(v)
-
-
-_DEFAULTS = NavigationConfig()
-_BLOCKED_REPLAN_INTERVAL = 0.5
-"""s, least time between two replans triggered by a blocked path."""
 _PATH_SAMPLE_STEP = 0.1
 """m, spacing of the path samples checked for blocking."""
-
-
-_MAX_PLANNING_CELLS = 16_000_000
-"""Most cells :func:`subdivide` makes (4000 × 4000; the search keeps ~10 arrays of that size)."""
-
-
-def subdivide(grid: OccupancyGrid, max_resolution: float) -> OccupancyGrid:
-    """``grid`` with each cell split into ``k × k`` equal cells of at most ``max_resolution`` m.
-
-    The same walls at a finer raster (``grid`` itself when its cells are small enough): a
-    distance map measures centre to centre, so on a 0.5 m map an inflation below 0.5 m marks
-    no cell and a plan through the cells next to a wall keeps only 0.25 m from it, less than a
-    jackal's radius (the robot drove into the wall and stalled). On cells of ``max_resolution``
-    the inflation errs by at most half of it. The split stops short of
-    :data:`_MAX_PLANNING_CELLS` cells (a 1 km map of 0.5 m cells gets 0.25 m ones).
-    """
-    k = math.ceil(grid.resolution / max_resolution - 1e-9)
-    k = min(k, max(int(math.sqrt(_MAX_PLANNING_CELLS / grid.data.size)), 1))
-    if k <= 1:
-        return grid
-    data = np.repeat(np.repeat(grid.data, k, axis=0), k, axis=1)
-    return OccupancyGrid(data, grid.resolution / k, grid.origin, grid.unknown_is_occupied)
 
 
 def _ped_array(peds: Pedestrians) -> NDArray[np.float64]:
@@ -322,7 +106,7 @@ def _ped_array(peds: Pedestrians) -> NDArray[np.float64]:
     return np.hstack([pos, vel])
 
 
-class NavigationStack:
+class NavigationStack(PathPlanning, StuckRecovery):
     """Global planner + local planner with replanning and goal checking, for one robot.
 
     Args:
@@ -370,29 +154,29 @@ class NavigationStack:
         local_planner: LocalPlanner,
         *,
         robot_radius: float,
-        inflation_margin: float = _DEFAULTS.inflation_margin,
+        inflation_margin: float = DEFAULTS.inflation_margin,
         footprint_radius: float | None = None,
-        planning_resolution: float = _DEFAULTS.planning_resolution,
-        replan_period: float = _DEFAULTS.replan_period,
+        planning_resolution: float = DEFAULTS.planning_resolution,
+        replan_period: float = DEFAULTS.replan_period,
         goal_tolerance: tuple[float, float | None] = (
-            _DEFAULTS.goal_tolerance_xy,
-            _DEFAULTS.goal_tolerance_yaw,
+            DEFAULTS.goal_tolerance_xy,
+            DEFAULTS.goal_tolerance_yaw,
         ),
-        max_path_deviation: float = _DEFAULTS.max_path_deviation,
+        max_path_deviation: float = DEFAULTS.max_path_deviation,
         kinematics: str | None = None,
         intermediate_planner: IntermediatePlanner | None = None,
-        intermediate_period: float = _DEFAULTS.intermediate_period,
-        intermediate_window: float = _DEFAULTS.intermediate_window,
+        intermediate_period: float = DEFAULTS.intermediate_period,
+        intermediate_window: float = DEFAULTS.intermediate_window,
         global_costmap: GlobalCostmapConfig | None = None,
         local_costmap: LocalCostmapConfig | None = None,
-        replan_on_blocked: bool = _DEFAULTS.replan_on_blocked,
-        blocked_lookahead: float = _DEFAULTS.blocked_lookahead,
-        oscillation_timeout: float = _DEFAULTS.oscillation_timeout,
-        oscillation_distance: float = _DEFAULTS.oscillation_distance,
-        recovery_behaviors: tuple[RecoveryName, ...] = _DEFAULTS.recovery_behaviors,
-        back_up_distance: float = _DEFAULTS.back_up_distance,
-        back_up_speed: float = _DEFAULTS.back_up_speed,
-        rotate_speed: float = _DEFAULTS.rotate_speed,
+        replan_on_blocked: bool = DEFAULTS.replan_on_blocked,
+        blocked_lookahead: float = DEFAULTS.blocked_lookahead,
+        oscillation_timeout: float = DEFAULTS.oscillation_timeout,
+        oscillation_distance: float = DEFAULTS.oscillation_distance,
+        recovery_behaviors: tuple[RecoveryName, ...] = DEFAULTS.recovery_behaviors,
+        back_up_distance: float = DEFAULTS.back_up_distance,
+        back_up_speed: float = DEFAULTS.back_up_speed,
+        rotate_speed: float = DEFAULTS.rotate_speed,
         scan_range_max: float = math.inf,
     ) -> None:
         if not robot_radius > 0:
@@ -499,88 +283,6 @@ class NavigationStack:
         self._samples = np.zeros((0, 2))
         self._sample_s = np.zeros(0)
         self._last_blocked = -math.inf
-
-    @classmethod
-    def from_config(
-        cls,
-        cfg: NavigationConfig | Mapping[str, Any] | None,
-        robot_radius: float,
-        source: str | None = None,
-        *,
-        footprint_radius: float | None = None,
-        kinematics: str | None = None,
-        path: str | None = "navigation",
-        local_planner: LocalPlanner | None = None,
-        scan_range_max: float = math.inf,
-        goal_tolerance: tuple[float, float | None] | None = None,
-    ) -> NavigationStack:
-        """Build both planners through their registries from a ``navigation`` block.
-
-        Args:
-            cfg: the block (a model, a plain mapping, or ``None`` for all defaults).
-            robot_radius: radius of the robot's bounding circle (m).
-            source: file the block came from, for error messages.
-            footprint_radius: the footprint's inscribed radius (m), for narrow passages.
-            kinematics: the robot's kinematics name (checked against the local planner).
-            path: key path of the block inside ``source``, for error messages.
-            local_planner: a planner instance used instead of the block's (a trainer's).
-            scan_range_max: m, laser ranges at or past it are free space (the sensor's max).
-            goal_tolerance: ``(xy m, yaw rad or None)`` instead of the block's.
-
-        Raises:
-            ConfigError: naming ``source`` and the key path when the block is invalid.
-        """
-        sub = (lambda key: f"{path}.{key}") if path else (lambda key: key)
-        if cfg is None:
-            cfg = _DEFAULTS
-        elif not isinstance(cfg, NavigationConfig):
-            raw = dict(cfg)
-            # Check the planner blocks through their registries first: their errors keep their
-            # type (UnknownNameError with a close match) and the exact key path.
-            blocks: tuple[tuple[str, Any], ...] = (
-                ("global_planner", GLOBAL_PLANNERS),
-                ("local_planner", LOCAL_PLANNERS),
-                ("intermediate_planner", INTERMEDIATE_PLANNERS),
-            )
-            for key, registry in blocks:
-                if key in raw:
-                    spec = raw[key]
-                    registry.validate(
-                        {"type": spec} if isinstance(spec, str) else spec,
-                        source=source, path=sub(key),
-                    )
-            try:
-                cfg = NavigationConfig.model_validate(raw)
-            except ValidationError as e:
-                raise from_validation_error(e, source=source, prefix=path) from None
-        gp = GLOBAL_PLANNERS.build(cfg.global_planner, source=source, path=sub("global_planner"))
-        lp = local_planner if local_planner is not None else LOCAL_PLANNERS.build(
-            cfg.local_planner, source=source, path=sub("local_planner")
-        )
-        ip = INTERMEDIATE_PLANNERS.build(
-            cfg.intermediate_planner, source=source, path=sub("intermediate_planner")
-        )
-        try:
-            return cls(
-                gp, lp, robot_radius=robot_radius, inflation_margin=cfg.inflation_margin,
-                footprint_radius=footprint_radius,
-                planning_resolution=cfg.planning_resolution,
-                replan_period=cfg.replan_period,
-                goal_tolerance=goal_tolerance or (cfg.goal_tolerance_xy, cfg.goal_tolerance_yaw),
-                max_path_deviation=cfg.max_path_deviation, kinematics=kinematics,
-                intermediate_planner=ip, intermediate_period=cfg.intermediate_period,
-                intermediate_window=cfg.intermediate_window,
-                global_costmap=cfg.global_costmap, local_costmap=cfg.local_costmap,
-                replan_on_blocked=cfg.replan_on_blocked,
-                blocked_lookahead=cfg.blocked_lookahead,
-                oscillation_timeout=cfg.oscillation_timeout,
-                oscillation_distance=cfg.oscillation_distance,
-                recovery_behaviors=cfg.recovery_behaviors,
-                back_up_distance=cfg.back_up_distance, back_up_speed=cfg.back_up_speed,
-                rotate_speed=cfg.rotate_speed, scan_range_max=scan_range_max,
-            )
-        except ConfigError as e:
-            raise e.located(source=source, prefix=path) from None
 
     # -- state ----------------------------------------------------------------------------------
     @property
@@ -795,158 +497,6 @@ class NavigationStack:
         return self._inter_path if self._inter_path is not None else self._path
 
     # -- sensing, blocking, recovery ------------------------------------------------------------
-    def _sense(
-        self, obs: LocalObservation, q: NDArray[np.float64], pedestrians: Pedestrians | None
-    ) -> None:
-        """Fold this tick's scan into the costmaps and keep its returns (world frame)."""
-        ranges = np.asarray(obs.scan_ranges, dtype=np.float64).reshape(-1)
-        angles = np.asarray(obs.scan_angles, dtype=np.float64).reshape(-1)
-        self._obs = obs
-        self._scan_world = scan_to_world(q, ranges, angles, obs.scan_origin, self.scan_range_max)
-        lcm = self.local_costmap
-        if lcm is not None:
-            peds = pedestrians if pedestrians is not None and len(pedestrians) else None
-            lcm.update(
-                q,
-                scan_ranges=ranges if ranges.size and ranges.shape == angles.shape else None,
-                scan_angles=angles, scan_origin=obs.scan_origin, range_max=self.scan_range_max,
-                ped_positions=None if peds is None else peds.positions,
-                ped_velocities=None if peds is None else peds.velocities,
-            )
-        gcfg = self.global_costmap_config
-        if gcfg is not None and gcfg.use_scan:
-            self._fold_scan_into_global()
-
-    def _fold_scan_into_global(self) -> None:
-        """Mark and clear the last scan in the global obstacle layer (recomposed when planning)."""
-        gcm, obs = self.global_costmap, getattr(self, "_obs", None)
-        if gcm is None or obs is None:
-            return
-        ranges = np.asarray(obs.scan_ranges, dtype=np.float64).reshape(-1)
-        angles = np.asarray(obs.scan_angles, dtype=np.float64).reshape(-1)
-        if ranges.size == 0 or ranges.shape != angles.shape:
-            return
-        q = np.asarray(obs.pose, dtype=np.float64).reshape(3)
-        c, s = math.cos(q[2]), math.sin(q[2])
-        so = np.asarray(obs.scan_origin, dtype=np.float64).reshape(2)
-        sensor = q[:2] + np.array([c * so[0] - s * so[1], s * so[0] + c * so[1]])
-        p = gcm.params
-        update_obstacles(
-            gcm.obstacles, sensor, angles + q[2], ranges, obstacle_range=p.obstacle_range,
-            raytrace_range=p.raytrace_range, range_max=self.scan_range_max,
-        )
-
-    def _path_blocked(self, q: NDArray[np.float64]) -> bool:
-        """Whether the next ``blocked_lookahead`` m of path are blocked (rate-limited).
-
-        Blocked: a lethal or inscribed cell of the local costmap on the path, or a laser return
-        within ``robot_radius`` of it.
-        """
-        if (
-            not self.replan_on_blocked
-            or self._time < self._retry_after
-            or self._time - self._last_blocked < _BLOCKED_REPLAN_INTERVAL
-            or len(self._samples) == 0
-        ):
-            return False
-        i0 = int(np.argmin(np.hypot(*(self._samples - q[:2]).T)))
-        s0 = self._sample_s[i0]
-        within = (self._sample_s >= s0) & (self._sample_s <= s0 + self.blocked_lookahead)
-        ahead = self._samples[within]
-        if self.local_costmap is not None:
-            costs = self.local_costmap.master.cost_at(ahead, off_map=0)
-            if bool(np.any((costs >= INSCRIBED) & (costs != 255))):
-                return True
-        pts = self._scan_world
-        if len(pts) == 0 or len(ahead) == 0:
-            return False
-        d2 = np.sum((ahead[:, None, :] - pts[None, :, :]) ** 2, axis=-1)
-        return bool(np.min(d2) < self.robot_radius**2)
-
-    def _clear_costmaps(self) -> None:
-        """Forget the obstacle layers (recovery ``clear_costmap``)."""
-        if self.global_costmap is not None:
-            self.global_costmap.obstacles.costs[:] = 0
-            self.global_costmap.update()
-        if self.local_costmap is not None:
-            self.local_costmap.obstacles.costs[:] = 0
-
-    def _stuck(self, q: NDArray[np.float64]) -> bool:
-        """Feed the oscillation monitor; re-arm the recoveries once the robot got away."""
-        if self._stuck_xy is not None and float(np.hypot(*(q[:2] - self._stuck_xy))) > (
-            self.oscillation.distance + self.back_up_distance
-        ):
-            self._stuck_xy = None
-            self._recovery_index = 0
-        return self.oscillation.update(q[:2], self._time)
-
-    def _start_recovery(
-        self, obs: LocalObservation, q: NDArray[np.float64], v: NDArray[np.float64]
-    ) -> NDArray[np.float64] | None:
-        """Run the next applicable recovery; ``None`` lets the normal tick go on."""
-        if self._stuck_xy is None:
-            self._stuck_xy = q[:2].copy()
-        lim = obs.limits
-        drive = obs.kinematics or self.kinematics or infer_kinematics(lim)
-        while self._recovery_index < len(self.recovery_behaviors):
-            name = self.recovery_behaviors[self._recovery_index]
-            self._recovery_index += 1
-            if name == "clear_costmap":
-                self.recoveries.append(name)
-                self._clear_costmaps()
-                self.local_planner.reset()
-                self.oscillation.reset(q[:2], self._time)
-                self.replan(Pose2D.from_array(q), mark_scan=False)
-                return None
-            if name == "rotate" and drive != "ackermann" and lim.omega_max > 0:
-                omega = min(self.rotate_speed, float(lim.omega_max))
-                deadline = self._time + 1.5 * 2 * math.pi / omega + 2.0
-            elif name == "back_up" and lim.vx_min < 0 and rear_is_free(
-                q, self._scan_world, self.robot_radius, self.back_up_distance
-            ):
-                speed = min(self.back_up_speed, -float(lim.vx_min))
-                deadline = self._time + 2.0 * self.back_up_distance / speed + 2.0
-            else:
-                continue
-            self.recoveries.append(name)
-            self._recovery = RecoveryRun(name, q[:2].copy(), self._time, float(q[2]), 0.0, deadline)
-            self.status = NavStatus.RECOVERING
-            cmd = self._recover(obs, q, v)
-            if cmd is not None:
-                return cmd
-        if self.status is NavStatus.ACTIVE:
-            self.status = NavStatus.STUCK
-            return limit_command(np.zeros(3), v, lim, obs.dt)
-        return None
-
-    def _recover(
-        self, obs: LocalObservation, q: NDArray[np.float64], v: NDArray[np.float64]
-    ) -> NDArray[np.float64] | None:
-        """One tick of the running motion recovery; ``None`` once it has finished."""
-        run = self._recovery
-        lim = obs.limits
-        if run is None:
-            self.status = NavStatus.ACTIVE
-            return None
-        if run.name == "rotate":
-            run.track(float(q[2]))
-            done = run.turned >= 2 * math.pi - 0.05
-            cmd = np.array([0.0, 0.0, min(self.rotate_speed, float(lim.omega_max))])
-        else:
-            travelled = float(np.hypot(*(q[:2] - run.start_xy)))
-            left = self.back_up_distance - travelled
-            done = left <= 1e-3 or not rear_is_free(
-                q, self._scan_world, self.robot_radius, max(left, 0.0)
-            )
-            cmd = np.array([-min(self.back_up_speed, -float(lim.vx_min)), 0.0, 0.0])
-        if done or self._time >= run.deadline:
-            self._recovery = None
-            self.status = NavStatus.ACTIVE
-            self.local_planner.reset()
-            self.oscillation.reset(q[:2], self._time)
-            self.replan(Pose2D.from_array(q))
-            return None
-        return limit_command(cmd, v, lim, obs.dt)
 
     # -- internals ------------------------------------------------------------------------------
     def _base_speed(self, obs: LocalObservation) -> float:
@@ -1029,113 +579,4 @@ class NavigationStack:
         self._last_plan_time = self._time
         self._retry_after = -math.inf
 
-    def _planning_grid(
-        self, mark_scan: bool, *, footprint: bool = False
-    ) -> tuple[OccupancyGrid, Costmap | None]:
-        """The occupancy grid to plan on, and the global costmap's master when configured.
 
-        Without a global costmap: the inflated map (by the footprint radius when ``footprint``),
-        with the last scan's returns marked (inflated alike) when ``mark_scan``. With one: its
-        lethal/inscribed cells, after folding the last scan into its obstacle layer when
-        ``mark_scan`` (every tick already with ``use_scan``).
-        """
-        assert self.inflated is not None
-        gcm, gcfg = self.global_costmap, self.global_costmap_config
-        if gcm is not None and gcfg is not None:
-            if mark_scan and not gcfg.use_scan:
-                self._fold_scan_into_global()
-            master = gcm.update()
-            return master.to_occupancy(INSCRIBED), master
-        grid, radius = self.inflated, self.robot_radius
-        if footprint and self.inflated_footprint is not None and self.footprint_radius:
-            grid, radius = self.inflated_footprint, self.footprint_radius
-        if mark_scan and len(self._scan_world):
-            return mark_points(grid, self._scan_world, radius + self.inflation_margin), None
-        return grid, None
-
-    def _plan_on(
-        self, grid: OccupancyGrid, costmap: Costmap | None, start: Pose2D
-    ) -> NDArray[np.float64]:
-        gcfg = self.global_costmap_config
-        if costmap is not None and gcfg is not None and gcfg.cost_weight > 0:
-            return plan_on_costmap(
-                costmap, start, self.goal, cost_weight=gcfg.cost_weight, heuristic_weight=1.0,
-                smooth=True,
-            )
-        return self.global_planner.plan(grid, start, self.goal)
-
-    def _plan_from(self, start: Pose2D, *, mark_scan: bool = False) -> NDArray[np.float64]:
-        """Plan with the robot radius; where that fails, with the footprint's (narrow passages)."""
-        narrow = self.inflated_footprint is not None and self.global_costmap is None
-        if not (narrow and self._apart_for_the_circle(start)):
-            try:
-                path = self._plan_with(start, mark_scan, footprint=False)
-            except PlanningError:
-                if not narrow:
-                    raise
-            else:
-                self.footprint_plan = False
-                return path
-        path = self._plan_with(start, mark_scan, footprint=True)
-        self.footprint_plan = True
-        return path
-
-    def _apart_for_the_circle(self, start: Pose2D) -> bool:
-        """Whether start and goal lie in different free regions of :attr:`inflated`.
-
-        Then planning with the robot radius surely fails (a scan marked on the grid only blocks
-        more), so a replan in a narrow passage need not search the whole region first. The
-        8-connected regions are labelled once per map; a start in the inflated zone is not
-        judged (its way out is found by the planning).
-        """
-        assert self.inflated is not None
-        if self._wide_labels is None:
-            self._wide_labels = ndimage.label(
-                ~self.inflated.occupied, structure=np.ones((3, 3), dtype=bool)
-            )[0]
-        cells = self.inflated.world_to_cell(np.array([start.xy, self.goal.xy]))
-        if not bool(np.all(self.inflated.in_bounds(cells))):
-            return False
-        a, b = self._wide_labels[cells[:, 0], cells[:, 1]]
-        return bool(a > 0 and b > 0 and a != b)
-
-    def _plan_with(
-        self, start: Pose2D, mark_scan: bool, *, footprint: bool
-    ) -> NDArray[np.float64]:
-        assert self.inflated is not None
-        assert self.grid is not None
-        grid, costmap = self._planning_grid(mark_scan, footprint=footprint)
-        try:
-            return self._plan_on(grid, costmap, start)
-        except StartOccupied:
-            free = self._free_cell_near(grid, start)
-            if free is None:
-                raise
-        via = Pose2D(float(free[0]), float(free[1]), start.theta)
-        path = self._plan_on(grid, costmap, via)
-        return np.vstack([start.xy[None, :], path])
-
-    def _free_cell_near(
-        self, grid: OccupancyGrid, start: Pose2D
-    ) -> NDArray[np.float64] | None:
-        """Centre (m) of ``grid``'s free cell nearest to ``start``, if safely reachable."""
-        assert self.grid is not None
-        cell = grid.world_to_cell(start.xy)
-        blocked = grid.occupied
-        if not bool(grid.in_bounds(cell)) or bool(blocked.all()):
-            return None
-        # The inflated maps (not those with a scan marked) keep their nearest-free-cell table.
-        key = 0 if grid is self.inflated else 1 if grid is self.inflated_footprint else -1
-        if key in self._nearest_free:
-            idx = self._nearest_free[key]
-        else:
-            # One EDT with indices gives every cell's nearest free cell; computed on first need.
-            _, idx = ndimage.distance_transform_edt(blocked, return_indices=True)
-            if key >= 0:
-                self._nearest_free[key] = idx
-        r, c = int(cell[0]), int(cell[1])
-        free_cell = idx[:, r, c]
-        centre = grid.cell_to_world(free_cell)
-        if not segment_is_free(self.grid, start.xy, centre):
-            return None
-        return centre

@@ -13,7 +13,8 @@ from arena.core.types import Outcome, Pose2D
 from arena.experiment import run_episode
 from arena.maps.grid import OccupancyGrid
 from arena.nav import NavigationConfig, NavigationStack
-from arena.nav.stack import subdivide
+from arena.nav.build import stack_from_config
+from arena.nav.planning import subdivide
 from arena.robots.presets import load_robot
 from arena.sim.native2d import Native2DBackend
 from tests.conftest import make_episode
@@ -33,7 +34,7 @@ def _door_map(door: float, res: float = 0.05) -> OccupancyGrid:
 
 
 def _stack(**kw) -> NavigationStack:
-    return NavigationStack.from_config(
+    return stack_from_config(
         NavigationConfig(**kw), robot_radius=JACKAL.radius,
         footprint_radius=JACKAL.inscribed_radius,
     )

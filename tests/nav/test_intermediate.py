@@ -10,7 +10,8 @@ import pytest
 from arena.core.errors import UnknownNameError
 from arena.core.types import Pose2D
 from arena.maps.grid import OccupancyGrid
-from arena.nav import LocalObservation, NavigationStack
+from arena.nav import LocalObservation
+from arena.nav.build import stack_from_config
 from arena.nav.intermediate import (
     INTERMEDIATE_PLANNERS,
     AggressivePlanner,
@@ -207,7 +208,7 @@ def _obs(pose, t=0.0):
 
 
 def _stack(inter: str, **kw):
-    return NavigationStack.from_config(
+    return stack_from_config(
         {"intermediate_planner": inter, **kw}, robot_radius=0.3, kinematics="diff_drive"
     )
 
@@ -233,7 +234,7 @@ def test_stack_applies_and_restores_speed_overrides():
 
 def test_stack_bypass_changes_nothing():
     grid = OccupancyGrid.empty(10, 4, 0.05)
-    a, b = _stack("bypass"), NavigationStack.from_config(None, robot_radius=0.3)
+    a, b = _stack("bypass"), stack_from_config(None, robot_radius=0.3)
     for s in (a, b):
         s.reset(grid, Pose2D(1.0, 2.0, 0.0), Pose2D(9.0, 2.0, 0.0))
     ped = Pedestrians(positions=np.array([[2.0, 2.0]]), velocities=np.zeros((1, 2)))

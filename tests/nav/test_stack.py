@@ -25,6 +25,7 @@ from arena.nav import (
     NavStatus,
     PurePursuitPlanner,
 )
+from arena.nav.build import stack_from_config
 from arena.robots.limits import VelocityLimits
 
 RES = 0.05
@@ -219,14 +220,14 @@ def test_from_config_builds_planners_with_params() -> None:
         "goal_tolerance_xy": 0.2,
         "goal_tolerance_yaw": 0.1,
     }
-    nav = NavigationStack.from_config(cfg, robot_radius=0.25)
+    nav = stack_from_config(cfg, robot_radius=0.25)
     assert isinstance(nav.global_planner, AStarPlanner)
     assert nav.global_planner.params.heuristic_weight == 1.5
     assert isinstance(nav.local_planner, PurePursuitPlanner)
     assert nav.local_planner.params.lookahead == 0.9
     assert nav.replan_period == 0.0
     assert (nav.goal_tolerance_xy, nav.goal_tolerance_yaw) == (0.2, 0.1)
-    default = NavigationStack.from_config(None, robot_radius=0.25)
+    default = stack_from_config(None, robot_radius=0.25)
     assert default.goal_tolerance_xy == NavigationConfig().goal_tolerance_xy == 0.3
     assert default.goal_tolerance_yaw is None
     short = NavigationConfig(global_planner="astar", local_planner="pure_pursuit")
@@ -235,16 +236,16 @@ def test_from_config_builds_planners_with_params() -> None:
 
 def test_from_config_errors_name_the_file_and_key() -> None:
     with pytest.raises(UnknownNameError, match="did you mean 'astar'"):
-        NavigationStack.from_config({"global_planner": {"type": "astr"}}, 0.3)
+        stack_from_config({"global_planner": {"type": "astr"}}, 0.3)
     with pytest.raises(ConfigError, match=r"exp\.yaml: navigation\.local_planner.*lookahead"):
-        NavigationStack.from_config(
+        stack_from_config(
             {"local_planner": {"type": "pure_pursuit", "lookahead": -1}}, 0.3, source="exp.yaml"
         )
     with pytest.raises(ConfigError, match=r"navigation\.replan_perid"):
-        NavigationStack.from_config({"replan_perid": 1.0}, 0.3)
+        stack_from_config({"replan_perid": 1.0}, 0.3)
     # Valid at the block level but rejected when the stack is built: still located.
     with pytest.raises(ConfigError, match=r"exp\.yaml: navigation"):
-        NavigationStack.from_config({}, -0.3, source="exp.yaml")
+        stack_from_config({}, -0.3, source="exp.yaml")
 
 
 class _OmniOnly:

@@ -20,9 +20,10 @@ from arena.nav import (
     NavStatus,
     PurePursuitPlanner,
 )
+from arena.nav.build import stack_from_config
+from arena.nav.config import GlobalCostmapConfig, LocalCostmapConfig, NavigationConfig
 from arena.nav.costmap import LETHAL, Costmap
 from arena.nav.recovery import OscillationMonitor, mark_points, rear_is_free, sample_path
-from arena.nav.stack import GlobalCostmapConfig, LocalCostmapConfig, NavigationConfig
 from arena.robots.limits import VelocityLimits
 
 RES = 0.05
@@ -314,14 +315,14 @@ def test_config_blocks_validate_and_build() -> None:
         "oscillation_timeout": 5.0,
         "recovery_behaviors": ["rotate", "back_up"],
     }
-    nav = NavigationStack.from_config(cfg, robot_radius=0.25)
+    nav = stack_from_config(cfg, robot_radius=0.25)
     assert nav.global_costmap_config == GlobalCostmapConfig(use_scan=True, cost_weight=2.0)
     assert nav.recovery_behaviors == ("rotate", "back_up")
     assert nav.oscillation.timeout == 5.0 and nav.replan_on_blocked
     with pytest.raises(ConfigError, match=r"navigation\.global_costmap\.use_scn"):
-        NavigationStack.from_config({"global_costmap": {"use_scn": True}}, 0.3)
+        stack_from_config({"global_costmap": {"use_scn": True}}, 0.3)
     with pytest.raises(ConfigError, match=r"navigation\.recovery_behaviors"):
-        NavigationStack.from_config({"recovery_behaviors": ["dance"]}, 0.3)
+        stack_from_config({"recovery_behaviors": ["dance"]}, 0.3)
     defaults = NavigationConfig()
     assert defaults.global_costmap is None and defaults.local_costmap is None
     assert defaults.oscillation_timeout == 0.0 and not defaults.replan_on_blocked
@@ -391,7 +392,7 @@ def test_every_local_planner_runs_through_the_full_stack(name: str, kin: str) ->
         "replan_on_blocked": True,
         "oscillation_timeout": 1.0,
     }
-    nav = NavigationStack.from_config(cfg, robot_radius=RADIUS, kinematics=kin)
+    nav = stack_from_config(cfg, robot_radius=RADIUS, kinematics=kin)
     nav.scan_range_max = RANGE_MAX
     static = OccupancyGrid.empty(10.0, 6.0, RES)
     world = _box(static, 4.0, 4.8, 2.4, 3.6)
