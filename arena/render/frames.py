@@ -28,9 +28,16 @@ from matplotlib.figure import Figure
 from matplotlib.transforms import Bbox
 from numpy.typing import ArrayLike, NDArray
 
-from arena.core.errors import ConfigError
-from arena.core.geometry import regular_polygon, transform_points
+from arena.core.geometry import regular_polygon
 from arena.render import style
+from arena.render.layers import (
+    set_agents,
+    set_goals,
+    set_lidar,
+    set_paths,
+    set_robots,
+    set_trails,
+)
 from arena.render.layout import (
     BOX_PAD,
     LEGEND_FONT,
@@ -53,7 +60,6 @@ FloatArray = NDArray[np.float64]
 _DPI = DPI
 # Tiny extra canvas size so that ``int(inches · dpi)`` never truncates to one pixel too few.
 _PAD_PX = 1e-3
-_ROBOT_CIRCLE_SIDES = 40
 _AGENT_CIRCLE_SIDES = 24
 
 
@@ -235,12 +241,12 @@ class FrameRenderer:
         colliding = np.asarray(state.collisions.any, dtype=bool).reshape(-1)
         self._update_trails(state)
 
-        self._set_lidar(robots)
-        self._set_trails(robots, ov)
-        self._set_paths(ov)
-        self._set_goals(ov)
-        self._set_agents(agents)
-        self._set_robots(robots, colliding)
+        set_lidar(self._fans, self._hits, robots, self.lidar_specs, self.show_lidar)
+        set_trails(self._trails, robots, ov, self._trail, self.show_trails)
+        set_paths(self._paths, ov)
+        set_goals(self._goal_marks, self._goal_arrows, self._subgoals, self._arrow, ov)
+        set_agents(self._agents, self._agent_ticks, self._agent_circle, agents)
+        set_robots(self._robots, self._robot_heading, robots, colliding, self._px)
         # The caller's text replaces the default line, so callers that format time and step
         # themselves (with the outcome appended) do not get them twice.
         self._hud.set_text(ov.text or f"t = {state.time:.2f} s   step {state.step}")
@@ -466,146 +472,6 @@ class FrameRenderer:
         self._trail_key = (state.robots.names, state.step)
         self._trail.append(np.array(state.robots.poses[:, :2], dtype=np.float64))
 
-    def _set_lidar(self, robots: RobotStates) -> None:
-        fans: list[FloatArray] = []
-        fan_colors: list[tuple[float, float, float, float]] = []
-        hits: list[FloatArray] = []
-        hit_colors: list[style.RGB] = []
-        if self.show_lidar:
-            for i in range(len(robots)):
-                spec = self.lidar_specs[i] if i < len(self.lidar_specs) else None
-                if spec is None or i >= len(robots.scans):
-                    continue
-                ranges = np.asarray(robots.scans[i], dtype=np.float64).reshape(-1)
-                if ranges.size != spec.num_beams:
-                    raise ConfigError(
-                        f"robot {robots.names[i]!r}: scan has {ranges.size} beams but its "
-                        f"LidarSpec has num_beams={spec.num_beams}"
-                    )
-                origin, ends, hit = _scan_points(robots.poses[i], spec, ranges)
-                color = style.robot_color(i)
-                # The scanned area as one translucent polygon: one path instead of one line per
-                # beam keeps a 1000-beam scan as cheap to draw as a pedestrian.
-                fans.append(ends if spec.full_circle else np.vstack([origin[None], ends]))
-                fan_colors.append((*color, style.LIDAR_FAN_ALPHA))
-                hits.append(ends[hit])
-                hit_colors.extend([style.shade(color, 0.8)] * int(hit.sum()))
-        self._fans.set_verts(fans)
-        self._fans.set_facecolors(fan_colors if fan_colors else "none")
-        pts = np.concatenate(hits) if hits else np.zeros((0, 2))
-        self._hits.set_offsets(pts)
-        self._hits.set_facecolors(hit_colors if hit_colors else "none")
-
-    def _set_trails(self, robots: RobotStates, ov: Overlay) -> None:
-        segs: list[FloatArray] = []
-        colors: list[style.RGB] = []
-        if not self.show_trails:
-            pass
-        elif ov.trails is not None:
-            for i, tr in enumerate(ov.trails):
-                if tr is not None and len(tr) >= 2:
-                    segs.append(np.asarray(tr, dtype=np.float64)[:, :2])
-                    colors.append(style.shade(style.robot_color(i), style.TRAIL_TINT))
-        elif self.show_trails and len(self._trail) >= 2:
-            hist = np.stack(tuple(self._trail))  # (k, r, 2)
-            for i in range(min(hist.shape[1], len(robots))):
-                segs.append(hist[:, i])
-                colors.append(style.shade(style.robot_color(i), style.TRAIL_TINT))
-        self._trails.set_segments(segs)
-        self._trails.set_color(colors if colors else "none")
-
-    def _set_paths(self, ov: Overlay) -> None:
-        segs: list[FloatArray] = []
-        colors: list[style.RGB] = []
-        for i, path in enumerate(ov.paths or ()):
-            if path is None:
-                continue
-            p = np.asarray(path, dtype=np.float64).reshape(-1, np.shape(path)[-1])[:, :2]
-            if len(p) >= 2:
-                segs.append(p)
-                colors.append(style.robot_color(i))
-        self._paths.set_segments(segs)
-        self._paths.set_color(colors if colors else "none")
-
-    def _set_goals(self, ov: Overlay) -> None:
-        marks = np.zeros((0, 2))
-        mark_colors: list[style.RGB] = []
-        arrows: list[FloatArray] = []
-        arrow_colors: list[style.RGB] = []
-        if ov.goals is not None:
-            g = np.atleast_2d(np.asarray(ov.goals, dtype=np.float64))
-            ok = np.all(np.isfinite(g[:, :2]), axis=1)
-            marks = g[ok, :2]
-            mark_colors = [style.robot_color(i) for i in np.flatnonzero(ok)]
-            if g.shape[1] >= 3:
-                for i in np.flatnonzero(ok & np.isfinite(g[:, 2])):
-                    arrows.append(transform_points(self._arrow, g[i, :3]))
-                    arrow_colors.append(style.robot_color(int(i)))
-        self._goal_marks.set_offsets(marks)
-        self._goal_marks.set_edgecolors(mark_colors if mark_colors else "none")
-        self._goal_arrows.set_verts(arrows)
-        self._goal_arrows.set_facecolors(arrow_colors if arrow_colors else "none")
-        self._goal_arrows.set_edgecolors([style.shade(c, 0.6) for c in arrow_colors] or "none")
-
-        subs = np.zeros((0, 2))
-        sub_colors: list[style.RGB] = []
-        if ov.subgoals is not None:
-            sg = np.atleast_2d(np.asarray(ov.subgoals, dtype=np.float64))
-            ok = np.all(np.isfinite(sg[:, :2]), axis=1)
-            subs = sg[ok, :2]
-            sub_colors = [style.shade(style.robot_color(i), 1.35) for i in np.flatnonzero(ok)]
-        self._subgoals.set_offsets(subs)
-        self._subgoals.set_facecolors(sub_colors if sub_colors else "none")
-
-    def _set_agents(self, agents: AgentStates) -> None:
-        n = len(agents)
-        if n == 0:
-            self._agents.set_verts([])
-            self._agent_ticks.set_segments([])
-            return
-        pos = np.asarray(agents.positions, dtype=np.float64)
-        rad = np.asarray(agents.radii, dtype=np.float64)
-        verts = pos[:, None, :] + rad[:, None, None] * self._agent_circle[None]
-        self._agents.set_verts(verts)
-        self._agents.set_facecolors(style.palette(style.AGENT_STATE_COLORS, agents.states))
-        edge = style.palette(style.AGENT_KIND_COLORS, agents.kinds)
-        self._agents.set_edgecolors(edge)
-        head = np.asarray(agents.headings, dtype=np.float64)
-        direction = np.stack([np.cos(head), np.sin(head)], axis=-1)
-        ticks = np.stack([pos, pos + 1.3 * rad[:, None] * direction], axis=1)  # (n, 2, 2)
-        self._agent_ticks.set_segments(ticks)
-        self._agent_ticks.set_color(edge)
-
-    def _set_robots(self, robots: RobotStates, colliding: NDArray[np.bool_]) -> None:
-        polys: list[FloatArray] = []
-        heads: list[FloatArray] = []
-        faces: list[style.RGB] = []
-        edges: list[style.RGB] = []
-        widths: list[float] = []
-        for i in range(len(robots)):
-            pose = np.asarray(robots.poses[i], dtype=np.float64)
-            fp = robots.footprints[i] if i < len(robots.footprints) else None
-            radius = float(robots.radii[i])
-            if fp is None:
-                body = regular_polygon(radius, _ROBOT_CIRCLE_SIDES)
-                front = radius
-            else:
-                body = np.asarray(fp, dtype=np.float64)
-                # The heading line ends at the footprint's front-most point along body x.
-                front = max(float(body[:, 0].max()), 1e-3)
-            polys.append(transform_points(body, pose))
-            heads.append(transform_points(np.array([[0.0, 0.0], [front, 0.0]]), pose))
-            color = style.robot_color(i)
-            faces.append(color)
-            hit = bool(colliding[i]) if i < colliding.size else False
-            edges.append(style.COLLISION if hit else style.shade(color, 0.55))
-            widths.append(self._px(style.COLLISION_EDGE_PX if hit else style.ROBOT_EDGE_PX))
-        self._robots.set_verts(polys)
-        self._robots.set_facecolors(faces if faces else "none")
-        self._robots.set_edgecolors(edges if edges else "none")
-        self._robots.set_linewidths(widths if widths else [0.0])
-        self._robot_heading.set_segments(heads)
-
 
 def _rgba_to_rgb(rgba: NDArray[np.uint8]) -> NDArray[np.uint8]:
     """``(H, W, 4)`` → new contiguous ``(H, W, 3)``.
@@ -622,24 +488,6 @@ def _rgba_to_rgb(rgba: NDArray[np.uint8]) -> NDArray[np.uint8]:
     out[:, :, 2] = word >> 16
     return out
 
-
-def _scan_points(
-    pose: FloatArray, spec: LidarSpec, ranges: FloatArray
-) -> tuple[FloatArray, FloatArray, NDArray[np.bool_]]:
-    """Sensor origin ``(2,)``, beam end points ``(n, 2)`` and hit mask ``(n,)`` in the world.
-
-    Beams at (or beyond) ``range_max`` and non-finite ranges hit nothing: they reach full length
-    (bounding the scanned area) but are not drawn as hit points.
-    """
-    mount = np.asarray(spec.mount, dtype=np.float64)
-    origin = transform_points(mount[None, :2], pose)[0]
-    yaw = float(pose[2]) + float(mount[2])
-    finite = np.isfinite(ranges)
-    r = np.where(finite, np.minimum(ranges, spec.range_max), spec.range_max)
-    hit = finite & (ranges < spec.range_max - 1e-6)
-    ang = yaw + spec.angles()
-    ends = origin + r[:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
-    return origin, ends, hit
 
 
 def render_world(
