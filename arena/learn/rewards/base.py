@@ -14,6 +14,7 @@ path, :meth:`~arena.learn.rewards.function.RewardFunction.single`); terms that n
 
 from __future__ import annotations
 
+import abc
 import enum
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -213,7 +214,7 @@ SCALAR = ScalarOps()
 Ops = ArrayOps | ScalarOps
 
 
-class Term:
+class Term(abc.ABC):
     """A reward term: its :class:`Params` and one :meth:`formula` (see the module doc).
 
     Attributes:
@@ -225,13 +226,13 @@ class Term:
     def __init__(self, params: Any) -> None:
         self.params = params
 
+    @abc.abstractmethod
     def formula(self, inp: Any, ops: Any) -> tuple[Any, Any]:
         """``(reward, done or None)`` of the term.
 
         ``(N,)`` arrays for ``ops`` = :data:`ARRAY` on a :class:`RewardInput`; Python scalars for
         :data:`SCALAR` on a :class:`SingleRewardInput` (only :class:`ScalarTerm`).
         """
-        raise NotImplementedError
 
     def __call__(self, inp: RewardInput) -> TermResult:
         """Rewards ``(N,)`` for the ``N`` worlds of ``inp``."""
