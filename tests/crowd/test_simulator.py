@@ -68,7 +68,7 @@ def boxed_room(n, size, seed=0):
     Returns ``(world, spawn)``.
     """
     from arena.core.geometry import rectangle
-    from arena.crowd.simulator import crowd_clearance
+    from arena.crowd.clearance import crowd_clearance
 
     occ = np.zeros((round(size / 0.1),) * 2, dtype=bool)
     occ[:3] = occ[-3:] = occ[:, :3] = occ[:, -3:] = True
@@ -431,7 +431,7 @@ def _random_polygons(rng, grid, k):
 
 def test_crowd_clearance_is_the_full_distance_transform():
     """The map's cached clearance lowered near each obstacle == the transform of the union."""
-    from arena.crowd.simulator import crowd_clearance
+    from arena.crowd.clearance import crowd_clearance
     from arena.maps.distance import clearance_map
     from arena.maps.raster import polygon_mask
 
@@ -454,7 +454,7 @@ def test_crowd_clearance_is_the_full_distance_transform():
 
 def test_crowd_clearance_cache_follows_the_map():
     """Another grid (other occupancy, same shape) is computed afresh, not served the old map."""
-    from arena.crowd.simulator import crowd_clearance
+    from arena.crowd.clearance import crowd_clearance
     from arena.maps.distance import clearance_map
 
     occ = np.zeros((40, 50), dtype=bool)
