@@ -12,7 +12,7 @@ import math
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, StrictInt, model_validator
+from pydantic import BaseModel, ConfigDict, Field, StrictInt, field_validator, model_validator
 
 from arena.core.names import RULE, SafeLabel
 from arena.core.rng import Seed
@@ -63,6 +63,28 @@ class OutputConfig(_Strict):
     video_episodes: int = Field(3, ge=0, description="write videos for the first N episodes only")
     frame_every: int = Field(1, ge=1, description="render every N-th simulation step")
     width_px: int = Field(800, ge=200, le=4000, description="video frame width")
+    video_3d: Literal["auto", "none", "chase", "overview"] = Field(
+        "auto", description="a 3-D video per episode too (needs arena[3d]): chase camera behind "
+        "robot 0 or overview of the map; auto = chase on the mujoco backend, else none",
+    )
+    video_3d_size: tuple[int, int] = Field(
+        (640, 480), description="px, width and height of the 3-D video (even, 64..1920)"
+    )
+
+    @field_validator("video_3d_size")
+    @classmethod
+    def _even_size(cls, v: tuple[int, int]) -> tuple[int, int]:
+        if not all(64 <= n <= 1920 and n % 2 == 0 for n in v):
+            raise ValueError(f"expected two even sizes in 64..1920 px, got {list(v)}")
+        return v
+
+    def camera_3d(self, backend: str) -> Literal["chase", "overview"] | None:
+        """The 3-D video's camera for a run on ``backend`` (``None``: no 3-D video)."""
+        if not self.video or self.video_3d == "none":
+            return None
+        if self.video_3d == "auto":
+            return "chase" if backend == "mujoco" else None
+        return self.video_3d
 
 
 class EvaluationConfig(_Strict):

@@ -337,6 +337,20 @@ def _write_video(
         png = out_dir / "final.png"
         save_png(frame, png)
         files["final_frame"] = str(png)
+    camera = cfg.output.camera_3d(str(cfg.sim.backend.get("type", "native2d")))
+    if camera is not None:
+        from arena.render.video3d import write_video_3d  # the optional 3-D extra
+
+        path_3d = out_dir / f"video_3d.{cfg.output.video_format}"
+        w, h = cfg.output.video_3d_size
+        last = write_video_3d(
+            episode, [states[k] for k in drawn], [ov.text for ov in overlays], str(path_3d),
+            camera=camera, width=w, height=h, fps=fps,
+            params=getattr(backend, "params", None) and getattr(backend.params, "world", None),
+        )
+        files["video_3d"] = str(path_3d)
+        save_png(last, out_dir / "final_3d.png")
+        files["final_frame_3d"] = str(out_dir / "final_3d.png")
     return files
 
 

@@ -31,11 +31,13 @@ class EpisodeVideo:
         caption: "contestant · stage · episode k · outcome".
         matches_record: the re-simulated trajectory equals the recorded one (it should, always:
             ``False`` means the run is not reproducible and the video may differ).
+        path_3d: the 3-D video (``output.video_3d``; runs on the mujoco backend), if any.
     """
 
     path: Path
     caption: str
     matches_record: bool
+    path_3d: Path | None = None
 
 
 def pick_episodes(table: Any, count: int = 1) -> list[tuple[str, int]]:
@@ -104,7 +106,9 @@ def render_episode_video(
     if caption is None:
         caption = (f"{record.meta.stage or record.meta.map_name} · "
                    f"episode {record.meta.episode} · {record.meta.outcome}")
-    return EpisodeVideo(Path(res.files["video"]), caption, same)
+    video_3d = res.files.get("video_3d")
+    return EpisodeVideo(Path(res.files["video"]), caption, same,
+                        Path(video_3d) if video_3d else None)
 
 
 def episode_videos(

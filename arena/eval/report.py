@@ -163,10 +163,11 @@ def summary_html(rows: Sequence[SummaryRow], metrics: Sequence[str],
 def _poster(video: Path) -> str:
     """The poster of a video as a ``data:image/png`` URI ("" if there is none).
 
-    The episode's last frame (``final.png`` beside the video, written by ``run_episode``: it
-    shows the whole trajectory and the outcome), else the video's first frame.
+    The episode's last frame (``final.png`` beside ``video.mp4``, ``final_3d.png`` beside
+    ``video_3d.mp4``, written by ``run_episode``: it shows the whole trajectory and the
+    outcome), else the video's first frame.
     """
-    final = video.with_name("final.png")
+    final = video.with_name(video.stem.replace("video", "final", 1) + ".png")
     if final.is_file():
         return "data:image/png;base64," + base64.b64encode(final.read_bytes()).decode("ascii")
     try:
@@ -386,6 +387,8 @@ def main(
                                 workers=workers):
             note = "" if v.matches_record else " (re-simulation differs from the record)"
             clips.append((v.path, v.caption + note))
+            if v.path_3d is not None:
+                clips.append((v.path_3d, v.caption + " · 3-D" + note))
     clips.extend(videos)
     html_path = write_report(table, run, dest / "report.html", grids=grids, videos=clips,
                              workers=workers)

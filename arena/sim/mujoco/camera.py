@@ -127,6 +127,14 @@ class RgbdCamera:
     def __del__(self) -> None:
         self.close()
 
+    def remount(self, mount: tuple[float, float, float, float, float]) -> None:
+        """Move the camera on its base to ``mount`` ``(x, y, z m, yaw, pitch rad)``.
+
+        The image size and intrinsics stay (a video camera that follows a robot at a varying
+        distance and pitch).
+        """
+        self.spec = self.spec.model_copy(update={"mount": tuple(float(v) for v in mount)})
+
     def _place(self, data: Any, pose: ArrayLike) -> None:
         """Update the scene from ``data`` and set its GL camera to the spec's pose and frustum."""
         mj = self._mj
