@@ -21,7 +21,7 @@ try:
 except ConfigError:
     pytest.skip("3-D videos need the mujoco extra (arena[3d])", allow_module_level=True)
 
-from arena.render.video3d import Video3D  # noqa: E402  (after the headless GL is chosen)
+from arena.render.video3d import Video3D  # (after the headless GL is chosen)
 
 
 def states(n: int = 6, turn: float = 0.0):
@@ -105,7 +105,7 @@ def test_a_mujoco_run_writes_the_3d_video_and_the_report_shows_it(tmp_path):
         "task.robots.min_goal_distance=3",
         "output.video_3d_size=[160, 120]", "output.width_px=300",
     ])
-    out, results = run_experiment(cfg, tmp_path / "run")
+    _, results = run_experiment(cfg, tmp_path / "run")
     files = results[0].files
     assert files["video_3d"].endswith("video_3d.mp4")
     import imageio.v3 as iio
