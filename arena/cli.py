@@ -17,6 +17,7 @@ from rich.table import Table
 
 from arena.cli_bench import bench, report
 from arena.cli_common import PluginOption, console, err_console, load_plugin_options
+from arena.cli_compare import compare
 from arena.cli_world import maps_app, scenario_app, tasks_app
 from arena.core.errors import ArenaError, ConfigError
 
@@ -331,6 +332,7 @@ def train(
 
 
 app.command()(report)
+app.command()(compare)
 
 
 def main() -> None:
