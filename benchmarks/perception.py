@@ -1,0 +1,64 @@
+"""Perception speed on one core: the people tracker (the detectors come next, issue 20).
+
+    python benchmarks/perception.py [--people 20] [--frames 2000]
+
+Twenty people walking straight lines at 1.2 m/s through a 20 x 20 m area, detected every 0.1 s
+with 5 cm noise; prints the tracker's time per frame (predict, associate, update, birth and
+death). Goal (issue 20): lidar detector + tracker <= 1 ms per 720-beam scan with 20 people.
+"""
+
+from __future__ import annotations
+
+import os
+
+for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(var, "1")
+
+import argparse  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from arena.perception.mot import MotAccumulator  # noqa: E402
+from arena.perception.tracker import Tracker  # noqa: E402
+
+
+def main() -> None:
+    """Run the benchmark and print its figures."""
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--people", type=int, default=20)
+    ap.add_argument("--frames", type=int, default=2000)
+    args = ap.parse_args()
+    rng = np.random.default_rng(0)
+    n = args.people
+    start = rng.uniform(-10, 10, (n, 2))
+    heading = rng.uniform(-np.pi, np.pi, n)
+    vel = 1.2 * np.stack([np.cos(heading), np.sin(heading)], axis=1)
+    frames = []
+    for k in range(args.frames):
+        free = start + vel * (k * 0.1) + 10.0
+        truth = free % 20.0 - 10.0  # wrap around: a person leaving comes back as a new one
+        laps = np.floor(free / 20.0).astype(np.int64)
+        ids = np.arange(n) + n * (1000 * laps[:, 0] + laps[:, 1])
+        frames.append((k * 0.1, ids, truth, truth + rng.normal(0, 0.05, truth.shape)))
+    tracker = Tracker()
+    for t, _, _, det in frames[:50]:  # warm-up
+        tracker.update(t, det)
+    tracker.reset()
+    acc = MotAccumulator(0.5)
+    elapsed = 0.0
+    for t, ids, truth, det in frames:
+        t0 = time.perf_counter()
+        tracks = tracker.update(t, det)
+        elapsed += time.perf_counter() - t0
+        acc.add_frame(ids, truth, tracks.ids, tracks.positions)
+    per = elapsed / len(frames)
+    s = acc.scores()
+    print(f"tracker, {n} people, {len(frames)} frames (one core)")
+    print(f"  update:  {1e6 * per:8.1f} us/frame")
+    print(f"  MOTA {s.mota:.3f}  MOTP {s.motp:.3f} m  IDF1 {s.idf1:.3f}  id switches "
+          f"{s.id_switches}")
+
+
+if __name__ == "__main__":
+    main()
