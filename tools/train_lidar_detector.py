@@ -1,6 +1,8 @@
 """Train the lidar people detector on simulated scans and measure its AP on held-out maps.
 
-    python tools/train_lidar_detector.py [--episodes 40] [--steps 150] [-o arena/perception/data/lidar_people.npz]
+    python tools/train_lidar_detector.py [--episodes 60] [--steps 200] [-o WEIGHTS.npz]
+
+The defaults make the shipped weights (``arena/perception/data/lidar_people.npz``).
 
 Training data: ``--episodes`` episodes on generated ``rosnav_indoor`` maps with 20 walking
 people (``pysocial``), half with people seen as two legs (``pedestrian_body: legs``), half as
@@ -28,6 +30,7 @@ from arena.perception.lidar_detector import (
 
 
 def frames(map_type: str, body: str, episodes: int, steps: int, seed: int, offset: int = 0):
+    """Labelled scans of ``episodes`` episodes on ``map_type`` maps, people seen as ``body``."""
     cfg = load_config(None, [f"map={{type: {map_type}}}", "task.obstacles.static=3",
                              "task.obstacles.dynamic=20", f"sim.backend.pedestrian_body={body}",
                              "crowd.type=pysocial", f"seed={seed}", "output.video=false"])
@@ -35,9 +38,10 @@ def frames(map_type: str, body: str, episodes: int, steps: int, seed: int, offse
 
 
 def main() -> None:
+    """Draw the data, train, save, and print the held-out AP."""
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--episodes", type=int, default=40)
-    ap.add_argument("--steps", type=int, default=150)
+    ap.add_argument("--episodes", type=int, default=60)
+    ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("-o", "--out", type=Path, default=WEIGHTS)
     args = ap.parse_args()
     t0 = time.time()
