@@ -75,7 +75,8 @@ class LidarPeopleDetector:
             return np.zeros(0)
         z = (expand(segments.features) - self.mean) / self.scale
         h = np.tanh(z @ self.w1 + self.b1)
-        return 1.0 / (1.0 + np.exp(-(h @ self.w2 + self.b2)))
+        p: F64 = 1.0 / (1.0 + np.exp(-(h @ self.w2 + self.b2)))
+        return p
 
     def detect(
         self, ranges: ArrayLike, angles: ArrayLike, range_max: float
@@ -154,7 +155,7 @@ def train(
     arrays = {"mean": mean, "scale": scale, "w1": w1, "b1": b1, "w2": w2,
               "b2": np.array(b2), "features": np.array(FEATURES)}
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    np.savez(path, **arrays)  # type: ignore[arg-type]
+    np.savez(path, **arrays)
     return arrays
 
 
