@@ -32,6 +32,7 @@ import arena.eval.metrics
 import arena.maps.generators
 import arena.maps.sources
 import arena.nav
+import arena.perception.stage
 import arena.robots
 import arena.sim.native2d
 import arena.tasks.base  # noqa: F401  (task modes are declared there, imported when named)

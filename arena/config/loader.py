@@ -30,6 +30,7 @@ from arena.maps.sources import MAP_SOURCES
 from arena.nav.global_planners.base import GLOBAL_PLANNERS
 from arena.nav.intermediate.base import INTERMEDIATE_PLANNERS
 from arena.nav.local_planners.base import LOCAL_PLANNERS
+from arena.perception.stage import PERCEPTION
 from arena.robots.presets import load_robot
 from arena.sim.backend import BACKENDS
 from arena.tasks.base import validate_mode
@@ -221,6 +222,7 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
     GLOBAL_PLANNERS.validate(
         cfg.navigation.global_planner, source=source, path="navigation.global_planner"
     )
+    PERCEPTION.validate(cfg.navigation.perception, source=source, path="navigation.perception")
     INTERMEDIATE_PLANNERS.validate(
         cfg.navigation.intermediate_planner, source=source,
         path="navigation.intermediate_planner",

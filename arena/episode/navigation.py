@@ -20,9 +20,9 @@ from arena.episode.runner import EpisodeHooks, EpisodeRunner
 from arena.maps.raster import planning_grid
 from arena.nav.build import stack_from_config
 from arena.nav.config import NavStatus
-from arena.nav.intermediate.base import Pedestrians
 from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack
+from arena.perception.stage import GroundTruthPeople, PeoplePerception
 from arena.sensors.spec import LidarReading, LidarSpec, lidar_geometry
 
 if TYPE_CHECKING:
@@ -83,6 +83,8 @@ class NavigationController(EpisodeHooks):
         robot: robot 0's model.
         scan_sensor: the lidar whose scan is the observation's ``scan_*`` fields
             (``navigation.scan_sensor``); every sensor is in its ``sensors`` by name.
+        perception: where the stack's people come from (``navigation.perception``,
+            :data:`~arena.perception.stage.PERCEPTION`; default: the ground truth).
 
     Attributes:
         goal: robot 0's current goal.
@@ -92,9 +94,11 @@ class NavigationController(EpisodeHooks):
 
     def __init__(
         self, stack: NavigationStack, runtime: TaskRuntime, robot: RobotModel,
-        scan_sensor: str = "laser",
+        scan_sensor: str = "laser", perception: PeoplePerception | None = None,
     ) -> None:
         self.stack = stack
+        self.perception = perception if perception is not None else GroundTruthPeople()
+        self._range_max = float(robot.lidar(scan_sensor, path="navigation.scan_sensor").range_max)
         self.runtime = runtime
         self.robot = robot
         self.limits = robot.limits()
@@ -114,6 +118,7 @@ class NavigationController(EpisodeHooks):
         spawn = runner.episode.robots[0]
         self.goal = spawn.goal
         self.control_s = []
+        self.perception.reset()
         self.stack.reset(planning_grid(runner.episode), spawn.start, self.goal)
 
     def before_step(self, runner: EpisodeRunner) -> None:
@@ -174,11 +179,8 @@ class NavigationController(EpisodeHooks):
             time=state.time,
             kinematics=robot.kinematics_type,
         )
-        agents = state.agents
-        peds = Pedestrians(
-            positions=agents.positions, velocities=agents.velocities,
-            kinds=agents.kinds, states=agents.states,
-        )
+        peds = self.perception.people(state.time, state.robots.poses[0], scan, self._range_max,
+                                      state.agents)
         t_ctl = time.perf_counter()
         cmd = np.asarray(self.stack.step(obs, peds), dtype=np.float64)
         self.control_s.append(time.perf_counter() - t_ctl)

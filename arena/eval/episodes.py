@@ -35,6 +35,7 @@ from arena.eval.metrics import METRICS, compute_metrics
 from arena.eval.metrics.arena_set import path_length_value
 from arena.eval.record import EpisodeMeta, EpisodeRecord
 from arena.eval.recorder import Recorder
+from arena.perception.stage import PERCEPTION
 from arena.scene.episode import Episode
 from arena.scene.state import SimState
 from arena.sim.backend import SimulatorBackend
@@ -136,7 +137,8 @@ def run_episode(
     seed, idx = cfg.seed, episode.index
     dt = cfg.sim.dt
     nav = NavigationController(
-        build_stack(cfg.navigation, robot, episode), runtime, robot, cfg.navigation.scan_sensor
+        build_stack(cfg.navigation, robot, episode), runtime, robot, cfg.navigation.scan_sensor,
+        PERCEPTION.build(cfg.navigation.perception, path="navigation.perception"),
     )
     recorder = Recorder()
     contacts = _ContactCounter()
@@ -343,13 +345,13 @@ def _write_video(
 
         path_3d = out_dir / f"video_3d.{cfg.output.video_format}"
         w, h = cfg.output.video_3d_size
-        last = write_video_3d(
+        frame_3d = write_video_3d(
             episode, [states[k] for k in drawn], [ov.text for ov in overlays], str(path_3d),
             camera=camera, width=w, height=h, fps=fps,
             params=getattr(backend, "params", None) and getattr(backend.params, "world", None),
         )
         files["video_3d"] = str(path_3d)
-        save_png(last, out_dir / "final_3d.png")
+        save_png(frame_3d, out_dir / "final_3d.png")
         files["final_frame_3d"] = str(out_dir / "final_3d.png")
     return files
 

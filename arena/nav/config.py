@@ -113,6 +113,10 @@ class NavigationConfig(BaseModel):
         default_factory=lambda: {"type": "bypass"},
         description="intermediate planner block {type: name, **params}",
     )
+    perception: dict[str, Any] = Field(
+        default_factory=lambda: {"type": "ground_truth"},
+        description="where the planners' people come from {type: ground_truth | lidar, ...}",
+    )
     scan_sensor: str = Field(
         "laser", pattern=r"^[A-Za-z_][A-Za-z0-9_]*$",
         description="the robot's lidar2d sensor the stack and its costmaps read",
@@ -169,7 +173,8 @@ class NavigationConfig(BaseModel):
     # The planner blocks are checked against their registries where the file and key path are
     # known (the experiment loader, :func:`navigation_config`), not here: a pydantic
     # error would lose the UnknownNameError type and the exact key path inside the block.
-    @field_validator("global_planner", "local_planner", "intermediate_planner", mode="before")
+    @field_validator("global_planner", "local_planner", "intermediate_planner", "perception",
+                     mode="before")
     @classmethod
     def _shorthand(cls, v: Any) -> Any:
         return _planner_block(v)

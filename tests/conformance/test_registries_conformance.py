@@ -30,6 +30,7 @@ COVERED = {
     "metric": "tests/conformance/test_metrics_conformance.py",
     "reward term": "tests/learn/test_rewards.py",
     "sensor": "tests/sensors/test_named_sensors.py",
+    "people perception": "tests/perception/test_stage.py",
 }
 
 
