@@ -50,6 +50,7 @@ from arena.core.names import RULE, SafeName
 from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, check_worlds_folder, resolve_world
 from arena.nav.local_planners.base import LOCAL_PLANNERS
+from arena.perception.stage import PERCEPTION
 from arena.tasks.datafiles import find_data_file, read_arena_yaml
 from arena.tasks.suite_worlds import find_stage_world
 
@@ -182,6 +183,10 @@ class Contestant(_Arena):
         default_factory=dict,
         description="local planner parameters (our addition to Arena's format), e.g. "
         "{weights: runs/x/policy.npz} for rosnav_rl",
+    )
+    perception: dict[str, Any] | None = Field(
+        None, description="navigation.perception of this contestant (our addition), e.g. "
+        "{type: lidar}; default: the run's (the ground truth)",
     )
 
 
@@ -562,6 +567,10 @@ def contestant_config(
         path = f"contestants[{index}].params" + (f".{sub}" if sub else "")
         raise ConfigError(e.message, source=source, path=path) from None
     nav["local_planner"] = block
+    if contestant.perception is not None:
+        PERCEPTION.validate(contestant.perception, source=source,
+                            path=f"contestants[{index}].perception")
+        nav["perception"] = contestant.perception
     return ExperimentConfig.model_validate({**data, "name": contestant.name})
 
 

@@ -87,3 +87,25 @@ def test_a_planner_on_lidar_people_reaches_its_goal_in_the_corridor(tmp_path):
     ])
     _, (res,) = run_experiment(cfg, tmp_path)
     assert res.outcome == "success", res.error
+
+
+def test_a_contestant_may_plan_on_perceived_people(tmp_path):
+    from arena.config.schema import ExperimentConfig
+    from arena.tasks.suite import contestant_config, load_contest
+
+    good = tmp_path / "good.yaml"
+    good.write_text("contestants:\n  - {name: sf, local_planner: social_force}\n"
+                    "  - {name: sf_lidar, local_planner: social_force,\n"
+                    "     perception: {type: lidar}}\n")
+    contest, _ = load_contest(str(good))
+    base = ExperimentConfig()
+    assert contestant_config(base, contest.contestants[0]).navigation.perception == {
+        "type": "ground_truth"}
+    assert contestant_config(base, contest.contestants[1]).navigation.perception == {
+        "type": "lidar"}
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("contestants:\n  - {name: x, local_planner: dwa, perception: {type: lidr}}\n")
+    contest, _ = load_contest(str(bad))
+    with pytest.raises(ArenaError, match=r"bad\.yaml: contestants\[0\]\.perception.*lidr") as e:
+        contestant_config(base, contest.contestants[0], source=str(bad))
+    assert "\n" not in str(e.value)
