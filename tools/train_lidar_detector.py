@@ -43,6 +43,8 @@ def main() -> None:
     ap.add_argument("--episodes", type=int, default=60)
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("-o", "--out", type=Path, default=WEIGHTS)
+    ap.add_argument("--figure", type=Path, default=None,
+                    help="also draw the held-out precision-recall curves (PNG)")
     args = ap.parse_args()
     t0 = time.time()
     half = max(args.episodes // 2, 1)
@@ -56,6 +58,7 @@ def main() -> None:
     print(f"training data: {len(data)} scans, {len(y)} segments ({int(y.sum())} of people); "
           f"drawn in {t1 - t0:.1f} s, fitted in {t2 - t1:.1f} s")
     det = LidarPeopleDetector(args.out)
+    curves = {}
     for body in ("legs", "circle"):
         held = frames("canteen", body, 6, args.steps, 11) + frames("office", body, 6,
                                                                     args.steps, 12)
@@ -63,10 +66,29 @@ def main() -> None:
         people = [f.people for f in held]
         visible = [f.visible for f in held]
         aps = [average_precision(found, people, visible, r)[0] for r in (0.3, 0.5)]
+        curves[body] = average_precision(found, people, visible, 0.5)
         n_vis = sum(int(v.sum()) for v in visible)
         print(f"held out ({body}): {len(held)} scans, {n_vis} visible people: "
               f"AP@0.3 m {aps[0]:.3f}, AP@0.5 m {aps[1]:.3f}")
     print(f"wall time {time.time() - t0:.0f} s; weights: {args.out}")
+    if args.figure is not None:
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(5, 4), dpi=120)
+        ax = fig.add_subplot()
+        for body, (ap_05, recall, precision) in curves.items():
+            label = f"people as {'two legs' if body == 'legs' else 'body circles'} (AP {ap_05:.2f})"
+            ax.plot(recall, precision, label=label)
+        ax.set_xlabel("recall (visible people)")
+        ax.set_ylabel("precision")
+        ax.set_xlim(0, 1)
+        ax.set_ylim(0, 1.02)
+        ax.grid(alpha=0.3)
+        ax.set_title("lidar people detector, held-out maps, 0.5 m", fontsize=10)
+        ax.legend(loc="lower left", fontsize=8)
+        fig.tight_layout()
+        fig.savefig(args.figure)
+        print(f"figure: {args.figure}")
 
 
 if __name__ == "__main__":
