@@ -8,13 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from arena.core.errors import ConfigError
 from arena.export.world3d import export_scene, load_export_source
 from arena.maps.io import load_map
 from arena.maps.obstacles import obstacle_model
 from arena.maps.sources import resolve_world
 from arena.sim.mujoco.walls import merge_boxes
 from tests.cli_kit import run_cli
+from tests.mujoco_kit import require_mujoco
 
 
 def floats(el: ET.Element | None) -> list[float]:
@@ -80,12 +80,7 @@ def test_sdf_without_people_says_so(monkeypatch, capsys, tmp_path: Path) -> None
 
 
 def test_mjcf_parses_back_to_the_builders_geoms(monkeypatch, capsys, tmp_path: Path) -> None:
-    from arena.sim.mujoco.mjcf import import_mujoco
-
-    try:
-        mujoco = import_mujoco()
-    except ConfigError:
-        pytest.skip("needs the mujoco extra (arena[3d])")
+    mujoco = require_mujoco(module=False)
     code, _, err = run_cli(monkeypatch, capsys, "maps", "export", "small_office", "--scenario",
                            "default", "--format", "mjcf", "-o", str(tmp_path))
     assert code == 0, err

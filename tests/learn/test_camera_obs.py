@@ -10,7 +10,7 @@ from arena.learn.batched import BatchedSocialNavEnv
 from arena.learn.env import SocialNavEnv
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
-from arena.sim.mujoco.mjcf import import_mujoco
+from tests.mujoco_kit import require_mujoco
 
 ROOM = ["map.type=empty", "map.width=8", "map.height=8", "task.obstacles.static=2",
         "task.obstacles.dynamic=3", "task.robots.min_goal_distance=3", "sim.backend.type=mujoco"]
@@ -25,10 +25,7 @@ def camera_jackal() -> RobotModel:
 
 
 def test_depth_and_colour_observations_are_the_cameras_frames():
-    try:
-        import_mujoco()  # (not pytest.importorskip: arena chooses the headless GL first)
-    except ConfigError:
-        pytest.skip("the mujoco backend needs the mujoco extra (arena[3d])")
+    require_mujoco(module=False)
     env = SocialNavEnv(None, [*ROOM, "learning.env.observation.camera.sensor=front_cam",
                               "learning.env.observation.camera.channels=[depth, rgb]"],
                        robot=camera_jackal())

@@ -12,16 +12,12 @@ from arena.core.errors import ConfigError
 from arena.core.rng import derive_rng
 from arena.crowd.state import SocialState
 from arena.render import style
-from arena.sim.mujoco.mjcf import import_mujoco
+from arena.render.video3d import Video3D
 from arena.sim.native2d import Native2DBackend
+from tests.mujoco_kit import require_mujoco
 from tests.sim.mujoco.scenes import episode, people
 
-try:
-    import_mujoco()
-except ConfigError:
-    pytest.skip("3-D videos need the mujoco extra (arena[3d])", allow_module_level=True)
-
-from arena.render.video3d import Video3D  # (after the headless GL is chosen)
+require_mujoco()
 
 
 def states(n: int = 6, turn: float = 0.0):

@@ -27,17 +27,15 @@ from arena.scene.state import AgentStates
 from arena.sensors.base import SENSORS
 from arena.sim.backend import BACKENDS
 from arena.sim.mujoco.backend import MujocoBackend
-from arena.sim.mujoco.mjcf import import_mujoco, to_mjcf
+from arena.sim.mujoco.mjcf import to_mjcf
 from arena.sim.mujoco.params import MujocoParams
 from arena.sim.native2d import Native2DBackend
 from tests.eval._suites import stage
+from tests.mujoco_kit import require_mujoco
 from tests.sim.engine.helpers import assert_same_state
 from tests.sim.mujoco.scenes import episode, people
 
-try:
-    import_mujoco()
-except ConfigError:
-    pytest.skip("the mujoco backend needs the mujoco extra (arena[3d])", allow_module_level=True)
+require_mujoco()
 
 HALF = np.pi / 2
 

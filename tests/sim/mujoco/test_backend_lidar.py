@@ -5,21 +5,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from arena.core.errors import ConfigError
 from arena.core.rng import derive_rng
 from arena.core.types import Pose2D
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.sim.mujoco.backend import MujocoBackend
-from arena.sim.mujoco.mjcf import import_mujoco
 from arena.sim.mujoco.params import MujocoParams
 from arena.sim.native2d import Native2DBackend
+from tests.mujoco_kit import require_mujoco
 from tests.sim.mujoco.scenes import episode, people
 
-try:
-    import_mujoco()
-except ConfigError:
-    pytest.skip("the mujoco backend needs the mujoco extra (arena[3d])", allow_module_level=True)
+require_mujoco()
 
 
 # free poses in scenes.room(): around the wall stub, facing both boxes, near corners

@@ -11,14 +11,11 @@ from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.sensors.spec3d import RgbdFrame
 from arena.sim.mujoco.backend import MujocoBackend
-from arena.sim.mujoco.mjcf import import_mujoco
 from arena.sim.native2d import Native2DBackend
+from tests.mujoco_kit import require_mujoco
 from tests.sim.mujoco.scenes import episode, people
 
-try:
-    import_mujoco()
-except ConfigError:
-    pytest.skip("the mujoco backend needs the mujoco extra (arena[3d])", allow_module_level=True)
+require_mujoco()
 
 CAMERA = {"type": "rgbd", "width": 64, "height": 48, "fovy": 60.0, "near": 0.05, "far": 12.0,
           "update_rate": 10.0, "mount": [0.3, 0.0, 0.5, 0.0, 0.0]}

@@ -11,16 +11,13 @@ from arena.core.errors import ConfigError
 from arena.maps.grid import OccupancyGrid
 from arena.scene.episode import AgentSpawn
 from arena.sensors.spec3d import RgbdSpec
-from arena.sim.mujoco.mjcf import compile_model, import_mujoco
+from arena.sim.mujoco.camera import RgbdCamera, add_depth_noise, camera_pose
+from arena.sim.mujoco.mjcf import compile_model
 from arena.sim.mujoco.scene import PALETTE
 from arena.sim.mujoco.world import build_world
+from tests.mujoco_kit import require_mujoco, unavailable
 
-try:
-    mujoco = import_mujoco()
-except ConfigError:
-    pytest.skip("3-D worlds need the mujoco extra (arena[3d])", allow_module_level=True)
-
-from arena.sim.mujoco.camera import RgbdCamera, add_depth_noise, camera_pose
+mujoco = require_mujoco()
 
 ROOM = OccupancyGrid.empty(10.0, 6.0, 0.1)  # inner wall faces at x = 0.1, 9.9 and y = 0.1, 5.9
 
@@ -48,7 +45,7 @@ def room():
     try:
         RgbdCamera(model, cam_spec(width=8, height=8)).close()
     except ConfigError as e:  # mujoco without a GL library (tools/install_gl.sh installs it)
-        pytest.skip(str(e))
+        unavailable(str(e))
     return model, data
 
 

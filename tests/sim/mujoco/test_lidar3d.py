@@ -7,20 +7,16 @@ import math
 import numpy as np
 import pytest
 
-from arena.core.errors import ConfigError
 from arena.maps.grid import OccupancyGrid
 from arena.robots.presets import load_robot
 from arena.scene.episode import AgentSpawn
 from arena.sensors.spec3d import Lidar3DSpec
-from arena.sim.mujoco.mjcf import compile_model, import_mujoco
-from arena.sim.mujoco.world import build_world
-
-try:
-    mujoco = import_mujoco()
-except ConfigError:
-    pytest.skip("3-D worlds need the mujoco extra (arena[3d])", allow_module_level=True)
-
 from arena.sim.mujoco.lidar3d import Lidar3D, add_noise
+from arena.sim.mujoco.mjcf import compile_model
+from arena.sim.mujoco.world import build_world
+from tests.mujoco_kit import require_mujoco
+
+mujoco = require_mujoco()
 
 ROOM = OccupancyGrid.empty(10.0, 6.0, 0.1)  # inner wall faces at x = 0.1, 9.9 and y = 0.1, 5.9
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 
@@ -13,13 +11,11 @@ from arena.maps.obstacles import CircleFootprint, make_obstacle, obstacle_models
 from arena.robots.presets import load_robot
 from arena.scene.episode import AgentSpawn
 from arena.sim.mujoco.figures import pose_figures
-from arena.sim.mujoco.mjcf import compile_model, import_mujoco, person_ids_by_geom
+from arena.sim.mujoco.mjcf import compile_model, person_ids_by_geom
 from arena.sim.mujoco.world import build_world, robot_body
+from tests.mujoco_kit import require_mujoco, unavailable
 
-try:
-    mujoco = import_mujoco()  # first import: MUJOCO_GL=egl without a display
-except ConfigError:
-    pytest.skip("3-D worlds need the mujoco extra (arena[3d])", allow_module_level=True)
+mujoco = require_mujoco()
 
 GEOM_BOX = {"box": lambda s: s, "cylinder": lambda s: (s[0], s[0], s[1]),
             "sphere": lambda s: (s[0],) * 3, "ellipsoid": lambda s: s}
@@ -146,9 +142,7 @@ def test_render_is_deterministic_and_shows_walls() -> None:
         first = render(scene)
     except Exception as e:  # no EGL/OSMesa library: say what is missing
         message = f"offscreen rendering unavailable ({e}); run tools/install_gl.sh"
-        if os.environ.get("ARENA_REQUIRE_GL") == "1":
-            pytest.fail(message + " (ARENA_REQUIRE_GL=1: CI)")
-        pytest.skip(message)
+        unavailable(message)
     second = render(scene)
     assert first.shape == (240, 320, 3)
     np.testing.assert_array_equal(first, second)
