@@ -348,7 +348,7 @@ def _write_video(
         frame_3d = write_video_3d(
             episode, [states[k] for k in drawn], [ov.text for ov in overlays], str(path_3d),
             camera=camera, width=w, height=h, fps=fps,
-            params=getattr(backend, "params", None) and getattr(backend.params, "world", None),
+            params=getattr(getattr(backend, "params", None), "world", None),  # mujoco's world
         )
         files["video_3d"] = str(path_3d)
         save_png(frame_3d, out_dir / "final_3d.png")
