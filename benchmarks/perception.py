@@ -1,12 +1,15 @@
-"""Perception speed on one core: the lidar people detector and the tracker.
+"""Perception speed on one core: the lidar and RGB-D people detectors and the tracker.
 
-    python benchmarks/perception.py [--people 20] [--frames 2000]
+    python benchmarks/perception.py [--people 20] [--frames 2000] [--no-rgbd]
 
 Detector: 720-beam jackal scans of 20 walking people (seen as legs) on generated indoor maps,
 the time of :meth:`LidarPeopleDetector.detect` per scan. Tracker: ``--people`` people walking
 straight lines at 1.2 m/s through a 20 x 20 m area, detected every 0.1 s with 5 cm noise; its
 time per frame (predict, associate, update, birth and death) and its MOTA / MOTP / IDF1.
-Goal (issue 20): lidar detector + tracker <= 1 ms per 720-beam scan with 20 people.
+RGB-D detector (needs ``arena[3d]``): 320 x 240 frames of the training camera on the MuJoCo
+backend among 20 people, the time of :meth:`RgbdPeopleDetector.detect` per frame (shrinking,
+the network, clustering). Goals (issue 20): lidar detector + tracker <= 1 ms per 720-beam scan
+with 20 people; RGB-D detector >= 30 frames/s at 320 x 240.
 """
 
 from __future__ import annotations
@@ -33,6 +36,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--people", type=int, default=20)
     ap.add_argument("--frames", type=int, default=2000)
+    ap.add_argument("--rgbd", action=argparse.BooleanOptionalAction, default=True,
+                    help="also time the RGB-D detector (needs the 3-D extra)")
     args = ap.parse_args()
     rng = np.random.default_rng(0)
     n = args.people
@@ -78,6 +83,29 @@ def main() -> None:
     total = 1e3 * (per + per_scan)
     print(f"detector + tracker: {total:.2f} ms per scan (goal <= 1 ms): "
           f"{'meets' if total <= 1.0 else 'MISSES'}")
+    if args.rgbd:
+        rgbd()
+
+
+def rgbd() -> None:
+    """Time the RGB-D people detector on rendered frames."""
+    from arena.perception.rgbd_data import camera_frames
+    from arena.perception.rgbd_detector import RgbdPeopleDetector
+
+    cfg = load_config(None, ["map={type: canteen}", "task.obstacles.static=0",
+                             "task.obstacles.dynamic=20", "sim.backend.type=mujoco"])
+    frames = list(camera_frames(cfg, episodes=2, steps=100, every=2))
+    det = RgbdPeopleDetector()
+    for frame, spec, *_ in frames[:5]:
+        det.detect(frame, spec)
+    t0 = time.perf_counter()
+    for frame, spec, *_ in frames:
+        det.detect(frame, spec)
+    per = (time.perf_counter() - t0) / len(frames)
+    w, h = frames[0][1].width, frames[0][1].height
+    print(f"RGB-D people detector, {len(frames)} frames ({w} x {h}, 20 people)")
+    print(f"  detect:  {1e3 * per:8.2f} ms/frame = {1 / per:.0f} frames/s (goal >= 30): "
+          f"{'meets' if per <= 1 / 30 else 'MISSES'}")
 
 
 if __name__ == "__main__":

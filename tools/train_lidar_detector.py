@@ -21,12 +21,8 @@ import numpy as np
 
 from arena.config import load_config
 from arena.perception.lidar_data import labelled_frames
-from arena.perception.lidar_detector import (
-    WEIGHTS,
-    LidarPeopleDetector,
-    average_precision,
-    train,
-)
+from arena.perception.lidar_detector import WEIGHTS, LidarPeopleDetector, train
+from arena.perception.scoring import average_precision
 
 
 def frames(map_type: str, body: str, episodes: int, steps: int, seed: int, offset: int = 0):

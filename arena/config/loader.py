@@ -30,7 +30,7 @@ from arena.maps.sources import MAP_SOURCES
 from arena.nav.global_planners.base import GLOBAL_PLANNERS
 from arena.nav.intermediate.base import INTERMEDIATE_PLANNERS
 from arena.nav.local_planners.base import LOCAL_PLANNERS
-from arena.perception.stage import PERCEPTION
+from arena.perception.stage import check_perception
 from arena.robots.presets import load_robot
 from arena.sim.backend import BACKENDS
 from arena.tasks.base import validate_mode
@@ -222,7 +222,6 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
     GLOBAL_PLANNERS.validate(
         cfg.navigation.global_planner, source=source, path="navigation.global_planner"
     )
-    PERCEPTION.validate(cfg.navigation.perception, source=source, path="navigation.perception")
     INTERMEDIATE_PLANNERS.validate(
         cfg.navigation.intermediate_planner, source=source,
         path="navigation.intermediate_planner",
@@ -238,6 +237,7 @@ def validate_plugins(cfg: ExperimentConfig, *, source: str | None = None) -> Non
         robot.lidar(cfg.navigation.scan_sensor, path="navigation.scan_sensor")
     except ConfigError as e:
         raise e.located(source=source) from None
+    check_perception(cfg.navigation.perception, robot, source=source)
     kind = robot.kinematics_type
     supported = getattr(local.obj, "supports", frozenset())
     if kind not in supported:

@@ -22,7 +22,7 @@ from arena.nav.build import stack_from_config
 from arena.nav.config import NavStatus
 from arena.nav.local_planners.base import LocalObservation
 from arena.nav.stack import NavigationStack
-from arena.perception.stage import GroundTruthPeople, PeoplePerception
+from arena.perception.stage import GroundTruthPeople, PeoplePerception, Perceived, Senses
 from arena.sensors.spec import LidarReading, LidarSpec, lidar_geometry
 
 if TYPE_CHECKING:
@@ -90,6 +90,8 @@ class NavigationController(EpisodeHooks):
         goal: robot 0's current goal.
         control_s: wall time (s) of each stack call (global + intermediate + local).
         teleported: robot 0's recorded rows reached by a teleport (not driven).
+        perceived: ``(time s, Perceived)`` of each tick of a detecting perception plugin
+            (empty for the ground truth).
     """
 
     def __init__(
@@ -111,6 +113,7 @@ class NavigationController(EpisodeHooks):
         }
         self.goal: Pose2D | None = None
         self.control_s: list[float] = []
+        self.perceived: list[tuple[float, Perceived]] = []
 
     def initialize_episode(self, runner: EpisodeRunner) -> None:
         """Plan from robot 0's start to its goal."""
@@ -118,6 +121,7 @@ class NavigationController(EpisodeHooks):
         spawn = runner.episode.robots[0]
         self.goal = spawn.goal
         self.control_s = []
+        self.perceived = []
         self.perception.reset()
         self.stack.reset(planning_grid(runner.episode), spawn.start, self.goal)
 
@@ -179,8 +183,10 @@ class NavigationController(EpisodeHooks):
             time=state.time,
             kinematics=robot.kinematics_type,
         )
-        peds = self.perception.people(state.time, state.robots.poses[0], scan, self._range_max,
-                                      state.agents)
+        peds = self.perception.people(Senses(state.time, state.robots.poses[0], scan,
+                                             self._range_max, sensors, state.agents))
+        if self.perception.last is not None:
+            self.perceived.append((state.time, self.perception.last))
         t_ctl = time.perf_counter()
         cmd = np.asarray(self.stack.step(obs, peds), dtype=np.float64)
         self.control_s.append(time.perf_counter() - t_ctl)

@@ -14,7 +14,7 @@ import dataclasses
 import json
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
@@ -34,8 +34,8 @@ from arena.eval.io import save_record
 from arena.eval.metrics import METRICS, compute_metrics
 from arena.eval.metrics.arena_set import path_length_value
 from arena.eval.record import EpisodeMeta, EpisodeRecord
-from arena.eval.recorder import Recorder
-from arena.perception.stage import PERCEPTION
+from arena.eval.recorder import Recorder, with_perception
+from arena.perception.stage import PERCEPTION, Perceived
 from arena.scene.episode import Episode
 from arena.scene.state import SimState
 from arena.sim.backend import SimulatorBackend
@@ -138,7 +138,7 @@ def run_episode(
     dt = cfg.sim.dt
     nav = NavigationController(
         build_stack(cfg.navigation, robot, episode), runtime, robot, cfg.navigation.scan_sensor,
-        PERCEPTION.build(cfg.navigation.perception, path="navigation.perception"),
+        PERCEPTION.build(cfg.navigation.perception, robot, path="navigation.perception"),
     )
     recorder = Recorder()
     contacts = _ContactCounter()
@@ -175,6 +175,7 @@ def run_episode(
             config=cfg.model_dump(mode="json"),
         )
     )
+    record = with_perception(record, nav.perceived)
     if cfg.evaluation.counterfactual and len(episode.agents):
         # The same crowd without the robot, from the stream the backend gave the pedestrians.
         track = replay_crowd(
@@ -216,7 +217,8 @@ def run_episode(
         result.files["record"] = str(save_record(record, out_dir / "episode.parquet"))
         if frames is not None and frames.states:
             result.files.update(
-                _write_video(cfg, backend, frames.states, frames.views, out_dir, outcome, episode)
+                _write_video(cfg, backend, frames.states, frames.views, out_dir, outcome, episode,
+                             nav.perceived)
             )
         result.wall_time = time.perf_counter() - t0
         (out_dir / "episode.json").write_text(json.dumps(result.summary(), indent=2))
@@ -297,12 +299,18 @@ class _Frames(EpisodeHooks):
 
 
 def _write_video(
-    cfg, backend, states, views, out_dir: Path, outcome: Outcome, episode: Episode
+    cfg, backend, states, views, out_dir: Path, outcome: Outcome, episode: Episode,
+    perceived: Sequence[tuple[float, Perceived]] = (),
 ) -> dict[str, str]:
-    """The episode's video and its last frame; ``views[k]`` is state ``k``'s (plan, goal)."""
+    """The episode's video and its last frame; ``views[k]`` is state ``k``'s (plan, goal).
+
+    ``perceived`` (``(time, Perceived)`` per control tick) draws the detections and tracks the
+    stack planned on over the state of the same time.
+    """
     # Imported here: rendering is optional and the only user of matplotlib.
     from arena.render import FrameRenderer, Overlay, VideoWriter, legend_items, save_png
 
+    at_time = {round(t, 9): p for t, p in perceived}
     last = len(states) - 1
     drawn = [k for k in range(len(states)) if k % cfg.output.frame_every == 0 or k == last]
     overlays = []
@@ -310,8 +318,13 @@ def _write_video(
         # no plan yet where planning failed at the start: the goal alone
         path, goal = views[k] if k < len(views) else (None, episode.robots[0].goal)
         text = f"t = {states[k].time:5.1f} s   step {states[k].step}"
-        overlays.append(Overlay(paths=[path], goals=goal.as_array()[None, :],
-                                text=text + (f"   {outcome.value}" if k == last else "")))
+        seen = at_time.get(round(states[k].time, 9))
+        overlays.append(Overlay(
+            paths=[path], goals=goal.as_array()[None, :],
+            text=text + (f"   {outcome.value}" if k == last else ""),
+            detections=None if seen is None else seen.detections,
+            tracks=None if seen is None else (seen.tracks.ids, seen.tracks.positions),
+        ))
     robot_specs = [spawn.model.laser for spawn in episode.robots]
     renderer = FrameRenderer(
         backend.world,

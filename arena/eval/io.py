@@ -7,10 +7,13 @@ collision_robot`` (bool). The pedestrian table (``K`` rows, long format) is stor
 file as list columns, each robot row holding the pedestrians of that step: ``ped_id, ped_kind,
 ped_state`` (list<int64>), ``ped_x, ped_y, ped_vx, ped_vy, ped_heading, ped_radius``
 (list<float64>), and, when the record has a counterfactual crowd, ``ped_cf_x, ped_cf_y``
-(list<float64>, NaN where the replay lacks the person). ``ped_row`` is implied by the list a
-pedestrian sits in. The meta data (with the resolved config) and the events are JSON in the
-schema metadata under ``arena.meta`` and ``arena.events`` (plus ``arena.format`` =
-``"episode-record/1"``).
+(list<float64>, NaN where the replay lacks the person); when the stack planned on detected
+people (:class:`~arena.eval.record.PerceptionRecord`), ``perceived`` (bool), ``ped_seen``
+(list<bool>, beside the other pedestrian lists), ``trk_id`` (list<int64>), ``trk_x, trk_y``
+and ``det_x, det_y`` (list<float64>, the tracks and detections of the row). ``ped_row`` is
+implied by the list a pedestrian sits in. The meta data (with the resolved config) and the
+events are JSON in the schema metadata under ``arena.meta`` and ``arena.events`` (plus
+``arena.format`` = ``"episode-record/1"``).
 
 The round trip is exact (values and dtypes) for records whose pedestrian rows are grouped by
 step in increasing ``ped_row`` order, which is what :class:`~arena.eval.recorder.Recorder`
@@ -33,7 +36,7 @@ import pyarrow.parquet as pq
 from numpy.typing import NDArray
 
 from arena.core.errors import ConfigError
-from arena.eval.record import EpisodeMeta, EpisodeRecord
+from arena.eval.record import EpisodeMeta, EpisodeRecord, PerceptionRecord
 
 FORMAT = "episode-record/1"
 _ROBOT_FLOATS = ("time", "x", "y", "theta", "vx", "vy", "omega",
@@ -119,12 +122,67 @@ def record_to_table(record: EpisodeRecord) -> pa.Table:
             cols[name] = _list_column(
                 np.ascontiguousarray(r.ped_cf_position[order, j]), offsets, pa.float64()
             )
+    if r.perception is not None:
+        cols.update(_perception_columns(r.perception, order, offsets, t))
     meta = {
         "arena.format": FORMAT,
         "arena.meta": json.dumps(_meta_to_json(r.meta)),
         "arena.events": json.dumps([list(e) for e in r.events]),
     }
     return pa.table(cols).replace_schema_metadata(meta)
+
+
+def _offsets(rows: NDArray[np.int64], t: int) -> tuple[NDArray[np.int64], NDArray[np.int32]]:
+    """Stable order of long-format ``rows`` by row, and the list offsets ``(t + 1,)``."""
+    order = np.argsort(rows, kind="stable")
+    offsets = np.zeros(t + 1, dtype=np.int32)
+    if rows.size:
+        np.cumsum(np.bincount(rows, minlength=t), out=offsets[1:])
+    return order, offsets
+
+
+def _perception_columns(
+    p: PerceptionRecord, ped_order: NDArray[np.int64], ped_offsets: NDArray[np.int32], t: int
+) -> dict[str, pa.Array]:
+    cols = {"perceived": pa.array(p.perceived, pa.bool_()),
+            "ped_seen": _list_column(p.seen[ped_order], ped_offsets, pa.bool_())}
+    order, offsets = _offsets(p.trk_row, t)
+    cols["trk_id"] = _list_column(p.trk_id[order].astype(np.int64), offsets, pa.int64())
+    for j, name in enumerate(("trk_x", "trk_y")):
+        cols[name] = _list_column(np.ascontiguousarray(p.trk_position[order, j]), offsets,
+                                  pa.float64())
+    order, offsets = _offsets(p.det_row, t)
+    for j, name in enumerate(("det_x", "det_y")):
+        cols[name] = _list_column(np.ascontiguousarray(p.det_position[order, j]), offsets,
+                                  pa.float64())
+    return cols
+
+
+def _perception_from(table: pa.Table) -> PerceptionRecord | None:
+    if "perceived" not in table.column_names:
+        return None
+
+    def col(name: str) -> pa.Array:
+        return table.column(name).combine_chunks()
+
+    def rows(name: str) -> NDArray[np.int64]:
+        counts = np.diff(col(name).offsets.to_numpy().astype(np.int64))
+        return np.repeat(np.arange(table.num_rows, dtype=np.int64), counts)
+
+    def flat(name: str, dtype: type) -> NDArray[Any]:
+        out: NDArray[Any] = col(name).flatten().to_numpy(zero_copy_only=False).astype(dtype)
+        return out
+
+    return PerceptionRecord(
+        perceived=col("perceived").to_numpy(zero_copy_only=False).astype(np.bool_),
+        seen=flat("ped_seen", np.bool_),
+        trk_row=rows("trk_id"), trk_id=flat("trk_id", np.int64),
+        trk_position=np.column_stack([flat("trk_x", np.float64),
+                                      flat("trk_y", np.float64)]).reshape(-1, 2),
+        det_row=rows("det_x"),
+        det_position=np.column_stack([flat("det_x", np.float64),
+                                      flat("det_y", np.float64)]).reshape(-1, 2),
+    )
 
 
 def table_to_record(table: pa.Table) -> EpisodeRecord:
@@ -176,6 +234,7 @@ def table_to_record(table: pa.Table) -> EpisodeRecord:
         ped_radius=fl["ped_radius"],
         events=events,
         ped_cf_position=cf,
+        perception=_perception_from(table),
     )
 
 

@@ -55,6 +55,40 @@ class EpisodeMeta:
 
 
 @dataclass(frozen=True, eq=False)
+class PerceptionRecord:
+    """What a detecting perception plugin (``navigation.perception``) saw, per robot row.
+
+    Attributes:
+        perceived: ``(T,)`` bool, the plugin ran on this row's state (a control tick).
+        seen: ``(K,)`` bool per pedestrian row: the plugin's sensors showed this person
+            (:class:`~arena.perception.stage.Perceived`); the tracking metrics score only them.
+        trk_row: ``(M,)`` robot row of each confirmed track (long format, like the people).
+        trk_id: ``(M,)`` track id.
+        trk_position: ``(M, 2)`` m, world frame.
+        det_row: ``(D,)`` robot row of each detection; det_position: ``(D, 2)`` m.
+    """
+
+    perceived: BoolArray
+    seen: BoolArray
+    trk_row: IntArray
+    trk_id: IntArray
+    trk_position: FloatArray
+    det_row: IntArray
+    det_position: FloatArray
+
+    def check(self, steps: int, ped_rows: int) -> None:
+        """Raise ``ValueError`` unless the shapes fit ``steps`` robot, ``ped_rows`` people rows."""
+        if self.perceived.shape != (steps,) or self.seen.shape != (ped_rows,):
+            raise ValueError("PerceptionRecord.perceived / seen must have the record's rows")
+        for row, pos, name in ((self.trk_row, self.trk_position, "trk"),
+                               (self.det_row, self.det_position, "det")):
+            if pos.shape != (row.shape[0], 2):
+                raise ValueError(f"PerceptionRecord.{name}_position must have shape (n, 2)")
+            if row.size and (row.min() < 0 or row.max() >= steps):
+                raise ValueError(f"PerceptionRecord.{name}_row must index the robot rows")
+
+
+@dataclass(frozen=True, eq=False)
 class EpisodeRecord:
     """Every step of one episode (struct of arrays).
 
@@ -81,6 +115,9 @@ class EpisodeRecord:
     (:mod:`arena.eval.counterfactual`); NaN where the replay has no such person, ``None`` when
     no replay was made.
 
+    Perception (optional): ``perception``, a :class:`PerceptionRecord` when the navigation stack
+    planned on detected people (``None`` for the ground truth).
+
     Events: ``events`` is a list of ``(time s, kind, detail)``, e.g. ``(12.3, "goal_reached",
     "")``, ``(4.0, "teleport", "robot 0")``.
     """
@@ -105,6 +142,7 @@ class EpisodeRecord:
     ped_radius: FloatArray
     events: list[tuple[float, str, str]] = field(default_factory=list)
     ped_cf_position: FloatArray | None = None
+    perception: PerceptionRecord | None = None
 
     def __post_init__(self) -> None:
         t = self.time.shape[0]
@@ -125,6 +163,8 @@ class EpisodeRecord:
                 raise ValueError(f"EpisodeRecord.{name} must have shape ({k}, 2)")
         if k and (self.ped_row.min() < 0 or self.ped_row.max() >= t):
             raise ValueError("EpisodeRecord.ped_row must index the robot rows")
+        if self.perception is not None:
+            self.perception.check(t, k)
 
     @property
     def steps(self) -> int:

@@ -14,15 +14,21 @@ the episode's end), whose record the metrics read and which also writes the epis
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from arena.episode.runner import EpisodeHooks, EpisodeRunner
-from arena.eval.record import EpisodeMeta, EpisodeRecord
+from arena.eval.record import EpisodeMeta, EpisodeRecord, PerceptionRecord
 from arena.scene.state import SimState
+
+if TYPE_CHECKING:
+    from arena.perception.stage import Perceived
 
 FloatArray = NDArray[np.float64]
 
@@ -233,3 +239,42 @@ class Recorder(EpisodeHooks):
             ped_radius=pf[:, 5].copy(),
             events=list(self.events),
         )
+
+
+def with_perception(
+    record: EpisodeRecord, log: Sequence[tuple[float, Perceived]]
+) -> EpisodeRecord:
+    """``record`` with what a detecting perception plugin saw; ``record`` itself without it.
+
+    ``log`` holds ``(time s, Perceived)`` of each control tick
+    (:attr:`~arena.episode.navigation.NavigationController.perceived`).
+
+    A tick belongs to the robot row of the same time (the state it perceived); its ``seen``
+    flags follow that row's pedestrians in their recorded order.
+    """
+    if not log:
+        return record
+    t, k = record.steps, record.ped_row.shape[0]
+    perceived = np.zeros(t, dtype=bool)
+    seen = np.zeros(k, dtype=bool)
+    starts = np.searchsorted(record.ped_row, np.arange(t + 1))  # ped rows grouped by row
+    trk: list[tuple[int, NDArray[np.int64], NDArray[np.float64]]] = []
+    det: list[tuple[int, NDArray[np.float64]]] = []
+    for time, p in log:
+        row = int(np.searchsorted(record.time, time - 1e-9))
+        if row >= t or abs(record.time[row] - time) > 1e-6:
+            continue  # a tick without a recorded state (none in a normal episode)
+        perceived[row] = True
+        a, b = starts[row], starts[row + 1]
+        m = min(b - a, p.seen.shape[0])
+        seen[a : a + m] = p.seen[:m]
+        trk.append((row, p.tracks.ids, p.tracks.positions))
+        det.append((row, p.detections))
+    trk_row = np.concatenate([np.full(len(ids), r, dtype=np.int64) for r, ids, _ in trk])
+    det_row = np.concatenate([np.full(len(xy), r, dtype=np.int64) for r, xy in det])
+    return dataclasses.replace(record, perception=PerceptionRecord(
+        perceived=perceived, seen=seen, trk_row=trk_row,
+        trk_id=np.concatenate([ids for _, ids, _ in trk]).astype(np.int64),
+        trk_position=np.concatenate([xy for *_, xy in trk]).reshape(-1, 2),
+        det_row=det_row, det_position=np.concatenate([xy for _, xy in det]).reshape(-1, 2),
+    ))

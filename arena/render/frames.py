@@ -35,6 +35,7 @@ from arena.render.layers import (
     set_goals,
     set_lidar,
     set_paths,
+    set_perception,
     set_robots,
     set_trails,
 )
@@ -84,6 +85,9 @@ class Overlay:
             may hold several lines (time, step, outcome).
         trails: per robot a ``(k, 2)`` trail of past positions (m); replaces the trail the
             renderer records itself.
+        detections: ``(d, 2)`` people a detector found (m, world frame): crosses.
+        tracks: ``(ids (k,), positions (k, 2) m)`` of tracked people: rings in a colour per
+            id, labelled with the id.
     """
 
     paths: Sequence[ArrayLike | None] | None = None
@@ -91,6 +95,8 @@ class Overlay:
     subgoals: ArrayLike | None = None
     text: str = ""
     trails: Sequence[ArrayLike | None] | None = None
+    detections: ArrayLike | None = None
+    tracks: tuple[ArrayLike, ArrayLike] | None = None
 
 
 class FrameRenderer:
@@ -247,6 +253,8 @@ class FrameRenderer:
         set_goals(self._goal_marks, self._goal_arrows, self._subgoals, self._arrow, ov)
         set_agents(self._agents, self._agent_ticks, self._agent_circle, agents)
         set_robots(self._robots, self._robot_heading, robots, colliding, self._px)
+        set_perception(self._detections, self._tracks, self._track_labels, ov,
+                       style.TRACK_LABEL_OFFSET_PX / self.scale)
         # The caller's text replaces the default line, so callers that format time and step
         # themselves (with the outcome appended) do not get them twice.
         self._hud.set_text(ov.text or f"t = {state.time:.2f} s   step {state.step}")
@@ -377,6 +385,19 @@ class FrameRenderer:
             linewidths=0.0,
             zorder=7.5,
         )
+        self._detections = ax.scatter(
+            empty[:, 0], empty[:, 1], s=px(style.DETECTION_MARKER_PX) ** 2, marker="x",
+            linewidths=px(2.0), c=[style.DETECTION], zorder=7.6,
+        )
+        self._tracks = ax.scatter(
+            empty[:, 0], empty[:, 1], s=px(style.TRACK_MARKER_PX) ** 2, marker="o",
+            facecolors="none", linewidths=px(2.0), zorder=7.7,
+        )
+        self._track_labels = [
+            ax.text(0.0, 0.0, "", fontsize=0.8 * self._font_size(), fontweight="bold",
+                    ha="left", va="bottom", zorder=7.8, visible=False, parse_math=False)
+            for _ in range(style.MAX_TRACK_LABELS)
+        ]
         self._robots = PolyCollection([], zorder=8)
         self._robot_heading = LineCollection(
             [],
@@ -424,6 +445,9 @@ class FrameRenderer:
                 self._robots,
                 self._robot_heading,
                 self._hud,
+                self._detections,
+                self._tracks,
+                *self._track_labels,
             ),
             key=lambda a: a.get_zorder(),
         )

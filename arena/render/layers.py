@@ -1,4 +1,4 @@
-"""The moving layers of a frame (lidar, trails, paths, goals, people, robots), given new data.
+"""The moving layers of a frame (lidar, trails, paths, goals, people, robots, perceived people).
 
 Each function fills matplotlib artists created once by :class:`~arena.render.frames.FrameRenderer`
 with one state's data (the renderer then blits them onto the static background).
@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib.collections import LineCollection, PathCollection, PolyCollection
+from matplotlib.text import Text
 from numpy.typing import NDArray
 
 from arena.core.errors import ConfigError
@@ -211,3 +212,33 @@ def _scan_points(
     ang = yaw + spec.angles()
     ends = origin + r[:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
     return origin, ends, hit
+
+
+def set_perception(
+    dets_art: PathCollection, tracks_art: PathCollection, labels: Sequence[Text], ov: Overlay,
+    label_offset: float,
+) -> None:
+    """Detected people (crosses) and tracks (rings coloured by id, labelled with the id).
+
+    ``label_offset`` (m) puts an id label up and right of its ring; tracks beyond the label
+    pool (:data:`~arena.render.style.MAX_TRACK_LABELS`) keep their ring without a label.
+    """
+    dets = np.zeros((0, 2)) if ov.detections is None else np.asarray(
+        ov.detections, dtype=np.float64).reshape(-1, 2)
+    dets_art.set_offsets(dets)
+    ids = np.zeros(0, dtype=np.int64)
+    pos = np.zeros((0, 2))
+    if ov.tracks is not None:
+        ids = np.asarray(ov.tracks[0], dtype=np.int64).reshape(-1)
+        pos = np.asarray(ov.tracks[1], dtype=np.float64).reshape(-1, 2)
+    tracks_art.set_offsets(pos)
+    colors = style.palette(style.TRACK_COLORS, ids)
+    tracks_art.set_edgecolors(colors)
+    for k, label in enumerate(labels):
+        if k < len(ids):
+            label.set_position((pos[k, 0] + label_offset, pos[k, 1] + label_offset))
+            label.set_text(str(int(ids[k])))
+            label.set_color(colors[k])
+            label.set_visible(True)
+        else:
+            label.set_visible(False)

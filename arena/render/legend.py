@@ -36,7 +36,9 @@ if TYPE_CHECKING:
 DPI = 100.0
 """Frame resolution (pixels per inch): sizes in pixels are ``points · DPI / 72``."""
 
-ELEMENTS: tuple[str, ...] = ("robot", "collision", "trail", "plan", "subgoal", "goal", "lidar")
+ELEMENTS: tuple[str, ...] = (
+    "robot", "collision", "trail", "plan", "subgoal", "goal", "lidar", "detection", "track",
+)
 """Legend names of the frame's elements, in legend order (social states follow)."""
 
 LABELS: dict[str, str] = {
@@ -47,6 +49,8 @@ LABELS: dict[str, str] = {
     "subgoal": "subgoal",
     "goal": "goal",
     "lidar": "lidar",
+    "detection": "detection",
+    "track": "track (id)",
 }
 """Text of each element's row."""
 
@@ -89,7 +93,8 @@ def legend_items(
     """The legend of frames of ``states`` drawn with ``overlays``: exactly what they show.
 
     Robots (and their trails and lidar) if any state has a robot, ``collision`` if any robot
-    collides in some state, ``plan``, ``goal`` and ``subgoal`` if some overlay holds one, and
+    collides in some state, ``plan``, ``goal``, ``subgoal``, ``detection`` and ``track`` if
+    some overlay holds one, and
     the social states the pedestrians take in ``states`` (codes without a name are not listed).
 
     Args:
@@ -116,6 +121,10 @@ def legend_items(
             items.append("goal")
         if _any_finite(ov.subgoals):
             items.append("subgoal")
+        if _any_finite(ov.detections):
+            items.append("detection")
+        if ov.tracks is not None and _any_finite(ov.tracks[1]):
+            items.append("track")
     codes: set[int] = set()
     for s in states:
         codes.update(int(c) for c in np.unique(np.asarray(s.agents.states)))
@@ -255,6 +264,13 @@ def _draw_symbol(ax: Axes, name: str, cx: float, cy: float, row: float) -> None:
         line([far] * 3, [cy - spread, cy, cy + spread], marker="o",
              markersize=_pt(style.LIDAR_HIT_PX), markerfacecolor=style.shade(color, 0.8),
              markeredgewidth=0.0, linestyle="none")
+    elif name == "detection":
+        line([cx], [cy], marker="x", markersize=_pt(min(style.DETECTION_MARKER_PX, 0.7 * row)),
+             markeredgecolor=style.DETECTION, markeredgewidth=_pt(2.0), linestyle="none")
+    elif name == "track":
+        line([cx], [cy], marker="o", markersize=_pt(min(style.TRACK_MARKER_PX, 0.8 * row)),
+             markerfacecolor="none", markeredgecolor=style.TRACK_COLORS[0],
+             markeredgewidth=_pt(2.0), linestyle="none")
     else:  # a social state: a pedestrian's disc in that state's colour
         code = style.AGENT_STATE_NAMES.index(name)
         line([cx], [cy], marker="o", markersize=_pt(0.7 * row),

@@ -78,6 +78,17 @@ AGENT_KIND_COLORS: tuple[RGB, ...] = tuple(
 )
 
 # -- overlays -----------------------------------------------------------------------------------
+# Perceived people (navigation.perception): detections as crosses, tracks as rings per id.
+DETECTION: RGB = hex_rgb("#d81b60")
+TRACK_COLORS: tuple[RGB, ...] = tuple(
+    hex_rgb(c) for c in ("#ff7f0e", "#2ca02c", "#9467bd", "#17becf", "#bcbd22", "#e377c2",
+                         "#393b79", "#637939", "#8c6d31", "#843c39")
+)  # none of them a robot's colour
+DETECTION_MARKER_PX = 9.0
+TRACK_MARKER_PX = 20.0
+TRACK_LABEL_OFFSET_PX = 8.0
+MAX_TRACK_LABELS = 48
+"""Most track ids labelled in one frame (a pool of text artists)."""
 TEXT: RGB = hex_rgb("#111111")
 TEXT_BOX: RGB = (1.0, 1.0, 1.0)
 TEXT_BOX_ALPHA = 0.8

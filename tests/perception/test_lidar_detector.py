@@ -9,7 +9,8 @@ from arena.config import load_config
 from arena.core.errors import ConfigError
 from arena.maps.grid import OccupancyGrid
 from arena.perception.lidar_data import labelled_frames
-from arena.perception.lidar_detector import LidarPeopleDetector, average_precision, train
+from arena.perception.lidar_detector import LidarPeopleDetector, train
+from arena.perception.scoring import average_precision
 from arena.sensors.lidar2d import Lidar2D
 from arena.sensors.spec import LidarSpec
 
@@ -41,20 +42,6 @@ def test_the_shipped_detector_finds_legs_and_bodies_and_not_the_walls():
     empty_xy, _ = det.detect(room_scan([]), SPEC.angles(), SPEC.range_max)
     assert len(empty_xy) == 0 or np.all(det.detect(room_scan([]), SPEC.angles(),
                                                    SPEC.range_max)[1] < 0.5)
-
-
-def test_average_precision_on_hand_made_detections():
-    people = [np.array([[0.0, 0.0], [5.0, 0.0]]), np.array([[1.0, 1.0]])]
-    visible = [np.array([True, True]), np.array([False])]
-    # frame 0: a sure hit, a wrong one, then the second person late; frame 1: a hidden person
-    dets = [(np.array([[0.1, 0.0], [9.0, 9.0], [5.2, 0.0]]), np.array([0.9, 0.8, 0.3])),
-            (np.array([[1.0, 1.1]]), np.array([0.95]))]
-    ap, recall, precision = average_precision(dets, people, visible, 0.5)
-    # ranked: hidden (ignored), hit (P 1, R .5), miss (P .5), hit (P 2/3, R 1)
-    assert recall.tolist() == [0.5, 0.5, 1.0]
-    assert precision.tolist() == pytest.approx([1.0, 0.5, 2 / 3])
-    assert ap == pytest.approx(0.5 * 1.0 + 0.5 * 2 / 3)
-    assert average_precision(dets, people, visible, 0.05)[0] == 0.0
 
 
 def test_training_on_simulated_scans_gives_a_working_detector(tmp_path):

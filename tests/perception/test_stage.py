@@ -11,7 +11,7 @@ from arena.experiment import run_experiment
 from arena.maps.grid import OccupancyGrid
 from arena.maps.sources import WORLDS_DIR
 from arena.nav.intermediate.base import Pedestrians
-from arena.perception.stage import PERCEPTION
+from arena.perception.stage import PERCEPTION, Senses
 from arena.scene.state import AgentStates
 from arena.sensors.lidar2d import Lidar2D
 from arena.sensors.spec import LidarReading, LidarSpec, lidar_geometry
@@ -40,14 +40,23 @@ def agents(xy: np.ndarray) -> AgentStates:
                        np.full(n, 0.3), z, z.copy())
 
 
-@pytest.mark.parametrize("name", PERCEPTION.names())
+SCAN_PLUGINS = ("ground_truth", "lidar")
+"""The plugins that need no camera (``tests/perception/test_camera_stage.py`` runs the rest)."""
+
+
+def test_every_perception_plugin_is_run_by_a_test():
+    assert set(PERCEPTION.names()) == {*SCAN_PLUGINS, "rgbd", "fused"}
+
+
+@pytest.mark.parametrize("name", SCAN_PLUGINS)
 def test_every_perception_plugin_gives_people_in_the_world_frame(name):
     plugin = PERCEPTION.build({"type": name})
     plugin.reset()
     for k in range(4):
         t = 0.1 * k
         people = np.array([[7.0 + 0.5 * t, 6.0], [3.0, 3.0 + 0.5 * t]])
-        out = plugin.people(t, POSE, reading(people, t), SPEC.range_max, agents(people))
+        out = plugin.people(Senses(t, POSE, reading(people, t), SPEC.range_max,
+                                   agents=agents(people)))
         assert isinstance(out, Pedestrians)
         pos = np.asarray(out.positions).reshape(-1, 2)
         vel = np.asarray(out.velocities).reshape(-1, 2)
@@ -64,7 +73,7 @@ def test_lidar_people_are_tracked_with_their_velocity_and_know_no_types():
     for k in range(20):
         t = 0.1 * k
         people = np.array([[6.5 + 0.8 * t, 6.5]])
-        out = plugin.people(t, POSE, reading(people, t), SPEC.range_max, None)
+        out = plugin.people(Senses(t, POSE, reading(people, t), SPEC.range_max))
     assert len(out) == 1
     assert np.asarray(out.velocities)[0] == pytest.approx([0.8, 0.0], abs=0.25)
     assert len(out.kinds) == 0 and len(out.states) == 0  # a scan shows neither

@@ -280,3 +280,28 @@ def test_a_still_picture_of_a_world_has_no_empty_text_box(world: StaticWorld) ->
     assert len(np.unique(corner, axis=0)) == 1  # background only
     timed = FrameRenderer(world, width_px=400, title="preview").render(_state())
     assert len(np.unique(timed[2:30, 2:30].reshape(-1, 3), axis=0)) > 1  # the time line's box
+
+
+def test_detections_are_crosses_and_tracks_rings_with_their_id(
+    renderer: FrameRenderer, frame: np.ndarray
+) -> None:
+    overlay = Overlay(detections=np.array([[6.0, 3.0]]),
+                      tracks=(np.array([4, 11]), np.array([[2.0, 6.5], [5.0, 4.0]])))
+    with_ov = renderer.render(_state(), overlay)
+    assert _has_color(_near(with_ov, renderer, (6.0, 3.0), 3), style.DETECTION)
+    assert not _has_color(_near(frame, renderer, (6.0, 3.0), 8), style.DETECTION)
+    # a ring around each track in its id's colour, hollow: the person's disc shows through
+    for tid, xy in ((4, (2.0, 6.5)), (11, (5.0, 4.0))):
+        colour = style.TRACK_COLORS[tid % len(style.TRACK_COLORS)]
+        assert _has_color(_near(with_ov, renderer, xy, 12), colour, tol=20), tid
+    assert np.array_equal(_pixel(with_ov, renderer, (2.0, 6.5)), _pixel(frame, renderer,
+                                                                       (2.0, 6.5)))
+    # the id label sits up and right of the ring
+    col, row = np.floor(renderer.world_to_pixel(np.array([5.0, 4.0]))).astype(int)
+    off = int(style.TRACK_LABEL_OFFSET_PX)
+    label = with_ov[row - off - 20 : row - off, col + off : col + off + 20].reshape(-1, 3)
+    assert _has_color(label.astype(int), style.TRACK_COLORS[11 % len(style.TRACK_COLORS)],
+                      tol=40)
+    # the next frame without perception draws none of it again
+    again = renderer.render(_state())
+    assert np.array_equal(again, frame)

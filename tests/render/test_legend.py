@@ -63,6 +63,12 @@ def test_legend_items_list_exactly_what_the_frames_show():
     # a single state draws no trail; a goal of NaN and a one-point path draw nothing
     empty = Overlay(paths=[np.zeros((1, 2)), None], goals=np.full((1, 3), np.nan))
     assert legend_items(quiet[:1], [empty], trails=True) == ("robot", "walking")
+    # perceived people: detections and tracks where some overlay has them
+    seen = Overlay(detections=np.array([[1.0, 1.0]]),
+                   tracks=(np.array([3]), np.array([[1.0, 1.2]])))
+    assert legend_items(quiet, [None, seen]) == ("robot", "detection", "track", "walking")
+    none_seen = Overlay(detections=np.zeros((0, 2)), tracks=(np.zeros(0), np.zeros((0, 2))))
+    assert legend_items(quiet, [none_seen]) == ("robot", "walking")
 
 
 def _near(img: np.ndarray, color: style.RGB, tol: int = 12) -> bool:
@@ -86,6 +92,8 @@ SIGNATURES: dict[str, style.RGB] = {
     "trail": style.shade(ROBOT, style.TRAIL_TINT),
     "subgoal": style.shade(ROBOT, 1.35),
     "lidar": style.shade(ROBOT, 0.8),
+    "detection": style.DETECTION,
+    "track": style.TRACK_COLORS[0],
     **{name: style.agent_state_color(code) for code, name in enumerate(style.AGENT_STATE_NAMES)},
 }
 
@@ -162,7 +170,7 @@ def test_a_tall_map_is_scaled_to_a_frame_no_taller_than_wide():
 
 def test_too_narrow_a_frame_for_the_legend_is_a_one_line_error():
     world = StaticWorld.build(OccupancyGrid.empty(4, 4, 0.1))
-    with pytest.raises(ConfigError, match=r"width_px 120 is too narrow for a legend of 14 entries"):
+    with pytest.raises(ConfigError, match=r"width_px 120 is too narrow for a legend of 16 entries"):
         FrameRenderer(world, width_px=120, legend=True)
     with pytest.raises(ConfigError, match=r"max_height_px must lie in \[16, 8000\]"):
         FrameRenderer(world, max_height_px=4)

@@ -6,7 +6,12 @@ displaced people (against the crowd replayed without it). :func:`compute_metrics
 of them.
 """
 
-from arena.eval.metrics import arena_set, counterfactual, social  # noqa: F401  (registers the built-ins)
+from arena.eval.metrics import (  # noqa: F401  (registers the built-ins)
+    arena_set,
+    counterfactual,
+    social,
+    tracking,
+)
 from arena.eval.metrics.base import (
     METRICS,
     Metric,

@@ -81,6 +81,10 @@ class MetricParams(BaseModel, frozen=True, extra="forbid"):
         0.2, gt=0, description="m, a person farther than this from their counterfactual "
         "position (the crowd replayed without the robot) counts as displaced",
     )
+    tracking_threshold: float = Field(
+        0.5, gt=0, description="m, a track farther than this from a person does not match them "
+        "(tracking metrics)",
+    )
     success_rule: Literal["goal", "arena"] = Field(
         "goal", description="when an episode succeeds: 'goal' (default) = outcome success and "
         "the final position inside the goal radius, collisions allowed (collisions never end an "

@@ -28,28 +28,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from arena.sensors.spec3d import RgbdFrame, RgbdSpec
+from arena.sensors.spec3d import RgbdFrame, RgbdSpec, camera_pose
 from arena.sim.mujoco.gl import gl_error, open_context
 from arena.sim.mujoco.mjcf import import_mujoco, person_ids_by_geom
-
-
-def camera_pose(
-    spec: RgbdSpec, pose: ArrayLike
-) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
-    """``(position, forward, up)`` of the camera in the world (m, unit vectors), each ``(3,)``.
-
-    ``pose`` is the robot base pose ``(x m, y m, yaw rad)``; the mount
-    ``(x, y, z, yaw, pitch)`` is applied in the base frame, pitch > 0 looking down.
-    """
-    x, y, yaw = (float(v) for v in np.asarray(pose, dtype=np.float64).reshape(3))
-    mx, my, mz, myaw, pitch = spec.mount
-    c, s = math.cos(yaw), math.sin(yaw)
-    pos = np.array([x + c * mx - s * my, y + s * mx + c * my, mz])
-    h = yaw + myaw
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    forward = np.array([cp * math.cos(h), cp * math.sin(h), -sp])
-    up = np.array([sp * math.cos(h), sp * math.sin(h), cp])
-    return pos, forward, up
 
 
 class RgbdCamera:
