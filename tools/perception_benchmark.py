@@ -7,7 +7,8 @@ carrying the detector's training camera (:data:`~arena.perception.rgbd_data.CAME
 ``camera``), every planner of the ``quick`` contest three times: on the ground truth, on lidar
 people and on RGB-D people (``perception: {type: ...}`` per contestant). Prints the Markdown
 table: success, collisions per episode, time a person spent in the robot's private zone, and
-the tracking scores of the perceived runs. Needs ``arena[3d]``.
+the tracking scores of the perceived runs (MOTA, recall and precision pooled over all
+episodes, IDF1 the episodes' mean). Needs ``arena[3d]``.
 """
 
 from __future__ import annotations
@@ -22,6 +23,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from arena.eval.io import load_record
+from arena.eval.metrics.tracking import mot_scores
 from arena.eval.store import load_results
 from arena.perception.rgbd_data import with_camera
 from arena.robots.presets import load_robot
@@ -55,11 +58,27 @@ def write_inputs(out: Path) -> tuple[Path, Path]:
     return suite_path, contest
 
 
+def pooled(run: Path, rows: list[dict]) -> tuple[float, float, float]:
+    """``(MOTA, recall, precision)`` of the tracks over all episodes of ``rows`` together.
+
+    A per-episode MOTA averages badly (an episode that saw one person for a second weighs as
+    much as one that saw twenty all the time); pooled, each person-frame counts once.
+    """
+    fn = fp = sw = gt = matched = hyp = 0
+    for r in rows:
+        s = mot_scores(load_record(run / r["record"]), 0.5)
+        if s is None:
+            return math.nan, math.nan, math.nan
+        fn, fp, sw = fn + s.misses, fp + s.false_positives, sw + s.id_switches
+        gt, matched, hyp = gt + s.ground_truth, matched + s.matches, hyp + s.hypotheses
+    return 1 - (fn + fp + sw) / max(gt, 1), matched / max(gt, 1), matched / max(hyp, 1)
+
+
 def table(run: Path) -> str:
     """The Markdown table of a finished run."""
     rows = load_results(run).to_pylist()
     lines = ["| planner | people from | success | collisions / ep | time in private zone (s) "
-             "| MOTA | IDF1 |", "|---|---|---|---|---|---|---|"]
+             "| MOTA | recall | precision | IDF1 |", "|---|---|---|---|---|---|---|---|---|"]
 
     def mean(rs: list[dict], key: str) -> float:
         v = np.array([r[key] for r in rs], dtype=np.float64)
@@ -72,11 +91,13 @@ def table(run: Path) -> str:
             rs = [r for r in rows if r["contestant"] == name]
             if not rs:
                 continue
-            mota, idf1 = mean(rs, "tracking_mota"), mean(rs, "tracking_idf1")
-            track = ("–", "–") if math.isnan(mota) else (f"{mota:.2f}", f"{idf1:.2f}")
+            mota, recall, precision = pooled(run, rs)
+            idf1 = mean(rs, "tracking_idf1")
+            track = ("–",) * 4 if math.isnan(mota) else (
+                f"{mota:.2f}", f"{recall:.2f}", f"{precision:.2f}", f"{idf1:.2f}")
             lines.append(f"| {p} | {LABEL[q]} | {100 * mean(rs, 'success'):.0f} % | "
                          f"{mean(rs, 'collisions'):.2f} | {mean(rs, 'time_in_private_zone'):.2f}"
-                         f" | {track[0]} | {track[1]} |")
+                         f" | {' | '.join(track)} |")
     return "\n".join(lines)
 
 

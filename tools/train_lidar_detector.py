@@ -26,9 +26,15 @@ from arena.perception.scoring import average_precision
 
 
 def frames(map_type: str, body: str, episodes: int, steps: int, seed: int, offset: int = 0):
-    """Labelled scans of ``episodes`` episodes on ``map_type`` maps, people seen as ``body``."""
+    """Labelled scans of ``episodes`` episodes on ``map_type`` maps, people seen as ``body``.
+
+    ``body``: ``legs`` or ``circle`` on the 2-D simulator, ``figure`` on the MuJoCo backend
+    (human figures among 3-D furniture: chairs and tables stand on thin legs there).
+    """
+    sim = (["sim.backend.type=mujoco"] if body == "figure"
+           else [f"sim.backend.pedestrian_body={body}"])
     cfg = load_config(None, [f"map={{type: {map_type}}}", "task.obstacles.static=3",
-                             "task.obstacles.dynamic=20", f"sim.backend.pedestrian_body={body}",
+                             "task.obstacles.dynamic=20", *sim,
                              "crowd.type=pysocial", f"seed={seed}", "output.video=false"])
     return list(labelled_frames(cfg, episodes, steps, every=5, episode_offset=offset))
 
@@ -39,6 +45,8 @@ def main() -> None:
     ap.add_argument("--episodes", type=int, default=60)
     ap.add_argument("--steps", type=int, default=200)
     ap.add_argument("-o", "--out", type=Path, default=WEIGHTS)
+    ap.add_argument("--figures", type=int, default=20,
+                    help="episodes on the MuJoCo backend (needs arena[3d]; 0: none)")
     ap.add_argument("--figure", type=Path, default=None,
                     help="also draw the held-out precision-recall curves (PNG)")
     args = ap.parse_args()
@@ -46,6 +54,10 @@ def main() -> None:
     half = max(args.episodes // 2, 1)
     data = frames("rosnav_indoor", "legs", half, args.steps, 1) + frames(
         "rosnav_indoor", "circle", half, args.steps, 2)
+    if args.figures:  # the 3-D world: figures among furniture on legs
+        part = max(args.figures // 2, 1)
+        data += frames("rosnav_indoor", "figure", part, args.steps, 3) + frames(
+            "canteen", "figure", part, args.steps, 4)
     x = np.concatenate([f.segments.features for f in data])
     y = np.concatenate([f.labels for f in data])
     t1 = time.time()
@@ -55,7 +67,7 @@ def main() -> None:
           f"drawn in {t1 - t0:.1f} s, fitted in {t2 - t1:.1f} s")
     det = LidarPeopleDetector(args.out)
     curves = {}
-    for body in ("legs", "circle"):
+    for body in ("legs", "circle", "figure"):
         held = frames("canteen", body, 6, args.steps, 11) + frames("office", body, 6,
                                                                     args.steps, 12)
         found = [det.people(f.segments, det.segment_scores(f.segments)) for f in held]
@@ -73,7 +85,8 @@ def main() -> None:
         fig = Figure(figsize=(5, 4), dpi=120)
         ax = fig.add_subplot()
         for body, (ap_05, recall, precision) in curves.items():
-            label = f"people as {'two legs' if body == 'legs' else 'body circles'} (AP {ap_05:.2f})"
+            name = {"legs": "two legs", "circle": "body circles", "figure": "3-D figures"}[body]
+            label = f"people as {name} (AP {ap_05:.2f})"
             ax.plot(recall, precision, label=label)
         ax.set_xlabel("recall (visible people)")
         ax.set_ylabel("precision")

@@ -1,6 +1,6 @@
 """Train the RGB-D people detector on auto-labelled MuJoCo frames; print its held-out AP.
 
-    python tools/train_rgbd_detector.py [--episodes 48] [--steps 160] [--epochs 24]
+    python tools/train_rgbd_detector.py [--episodes 48] [--steps 160] [--epochs 30]
                                         [-o WEIGHTS.npz] [--figure PR.png] [--example FRAME.png]
 
 Needs the 3-D extra (``arena[3d]``) and torch (``arena[train]``). Training frames: maps of
@@ -30,6 +30,7 @@ from arena.perception.rgbd_detector import (
     BLOB_FEATURES,
     CHANNELS,
     CLASSIFIER,
+    COLOUR,
     WEIGHTS,
     RgbdPeopleDetector,
     net_input,
@@ -51,9 +52,9 @@ def frames(map_type: str, episodes: int, steps: int, seed: int) -> list[RgbdSamp
     return list(labelled_frames(cfg, episodes, steps))
 
 
-def arrays(samples: list[RgbdSample]) -> tuple[np.ndarray, np.ndarray]:
+def arrays(samples: list[RgbdSample], colour: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Inputs ``(N, C, h, w)`` and labels ``(N, 1, h, w)`` float32."""
-    x = np.stack([net_input(s.depth, s.rgb, s.spec) for s in samples])
+    x = np.stack([net_input(s.depth, s.spec, s.rgb if colour else None) for s in samples])
     y = np.stack([s.mask for s in samples])[:, None].astype(np.float32)
     return x, y
 
@@ -101,7 +102,7 @@ def fit_offset(det: RgbdPeopleDetector, samples: list[RgbdSample]) -> float:
     det.offset = 0.0
     along = []
     for s in samples:
-        xy, _ = det.people(s.depth, det.pixel_scores(s.depth, s.rgb, s.spec), s.spec)
+        xy, _ = det.people(s.depth, det.pixel_scores(s.depth, s.spec, s.rgb), s.spec)
         cam = np.array(s.spec.mount[:2])
         for p in xy:
             d = np.hypot(*(s.people - p).T)
@@ -122,7 +123,7 @@ def candidate_labels(
     """
     feats, labels = [], []
     for s in samples:
-        xy, f = det.candidates(s.depth, det.pixel_scores(s.depth, s.rgb, s.spec), s.spec)
+        xy, f = det.candidates(s.depth, det.pixel_scores(s.depth, s.spec, s.rgb), s.spec)
         if not len(xy):
             continue
         cam = np.array(s.spec.mount[:2])
@@ -142,7 +143,7 @@ def candidate_labels(
 
 def evaluate(det: RgbdPeopleDetector, samples: list[RgbdSample]):  # type: ignore[no-untyped-def]
     """Detections of every sample, and ``(AP@0.3, AP@0.5, curve@0.5)``."""
-    found = [det.people(s.depth, det.pixel_scores(s.depth, s.rgb, s.spec), s.spec)
+    found = [det.people(s.depth, det.pixel_scores(s.depth, s.spec, s.rgb), s.spec)
              for s in samples]
     people = [s.people for s in samples]
     visible = [s.visible for s in samples]
@@ -155,10 +156,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--episodes", type=int, default=48)
     ap.add_argument("--steps", type=int, default=160)
-    ap.add_argument("--epochs", type=int, default=24)
+    ap.add_argument("--epochs", type=int, default=30)
     ap.add_argument("-o", "--out", type=Path, default=WEIGHTS)
     ap.add_argument("--figure", type=Path, default=None,
                     help="also draw the held-out precision-recall curve (PNG)")
+    ap.add_argument("--colour", action="store_true",
+                    help="add the colour channels (the shipped detector has none)")
     ap.add_argument("--cache", type=Path, default=None,
                     help="keep the generated frames in this pickle file and reuse them")
     args = ap.parse_args()
@@ -174,20 +177,21 @@ def main() -> None:
         if args.cache is not None:
             with args.cache.open("wb") as f:
                 pickle.dump((data, held), f)
-    x, y = arrays(data)
+    x, y = arrays(data, args.colour)
     t1 = time.time()
     print(f"{len(data)} training frames ({x.shape[2]} x {x.shape[3]}, "
           f"{y.mean():.1%} person pixels), {len(held)} held-out; {t1 - t0:.0f} s")
     weights = train(x, y, args.epochs)
     t2 = time.time()
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    np.savez(args.out, **weights, offset=np.array(0.0), channels=np.array(CHANNELS))
+    channels = CHANNELS + (COLOUR if args.colour else ())
+    np.savez(args.out, **weights, offset=np.array(0.0), channels=np.array(channels))
     det = RgbdPeopleDetector(args.out)
     offset = fit_offset(det, data)
     det.offset = offset
     feats, labels = candidate_labels(det, data)
     clf = fit_classifier(feats, labels)
-    np.savez(args.out, **weights, offset=np.array(offset), channels=np.array(CHANNELS),
+    np.savez(args.out, **weights, offset=np.array(offset), channels=np.array(channels),
              **clf.arrays(CLASSIFIER), blob_features=np.array(BLOB_FEATURES))
     print(f"candidate classifier: {len(labels)} candidates, {labels.sum()} people")
     det = RgbdPeopleDetector(args.out)

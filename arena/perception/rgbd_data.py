@@ -53,21 +53,30 @@ def with_camera(robot: RobotModel, spec: RgbdSpec = CAMERA, name: str = "camera"
     return RobotModel.model_validate(data)
 
 
-def shrink(
-    frame: RgbdFrame, stride: int = STRIDE
-) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-    """The detector's view of a frame: ``(depth (h, w) m, rgb (h, w, 3) in [0, 1])``.
+def shrink_depth(frame: RgbdFrame, stride: int = STRIDE) -> NDArray[np.float32]:
+    """The detector's depth image ``(H // stride, W // stride)`` (m) of a frame.
 
-    ``h = H // stride``, ``w = W // stride``. Depth is sampled at the centre pixel of each
-    ``stride × stride`` block (a mean would invent surfaces between a person and the wall
-    behind them); colour is the block's mean.
+    Depth is sampled at the centre pixel of each ``stride × stride`` block (a mean would invent
+    surfaces between a person and the wall behind them).
     """
     h, w = frame.depth.shape[0] // stride, frame.depth.shape[1] // stride
     c = stride // 2
-    depth = np.ascontiguousarray(frame.depth[c : h * stride : stride, c : w * stride : stride])
+    depth = frame.depth[c : h * stride : stride, c : w * stride : stride]
+    return np.ascontiguousarray(depth, dtype=np.float32)
+
+
+def shrink(
+    frame: RgbdFrame, stride: int = STRIDE
+) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """The frame on the detector's grid: ``(depth (h, w) m, rgb (h, w, 3) in [0, 1])``.
+
+    Depth as :func:`shrink_depth`; colour is each block's mean.
+    """
+    depth = shrink_depth(frame, stride)
+    h, w = depth.shape
     rgb = frame.rgb[: h * stride, : w * stride].reshape(h, stride, w, stride, 3)
     colour = rgb.mean(axis=(1, 3), dtype=np.float32) * np.float32(1.0 / 255.0)
-    return depth.astype(np.float32, copy=False), colour
+    return depth, colour
 
 
 @dataclass(frozen=True, eq=False)

@@ -295,3 +295,16 @@ def test_pool_stops_when_a_worker_cannot_start(monkeypatch: pytest.MonkeyPatch) 
     with pytest.raises(ArenaError, match=r"did not start within 0\.5 s"):
         _pool([1.0], math.sqrt, workers=1, initializer=time.sleep, initargs=(3600,))
     assert not mp.active_children()
+
+
+def test_workers_run_their_numeric_libraries_on_one_thread_each(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+    monkeypatch.setenv("NUMBA_NUM_THREADS", "3")  # what the user set stays
+    before = dict(os.environ)
+    names = ["OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "NUMBA_NUM_THREADS"]
+    got = _pool(names, os.getenv, workers=1)
+    assert got[0] == "1" and got[2] == "3"
+    assert got[1] == os.environ.get("OMP_NUM_THREADS", "1")
+    assert dict(os.environ) == before  # set for the worker only

@@ -33,9 +33,9 @@ def test_a_pixel_on_the_optical_axis_lands_where_the_tilted_camera_looks_at_the_
 
 
 def test_the_shipped_detector_finds_the_people_of_the_golden_frame_and_not_the_box():
-    depth, rgb, pose, people = golden()
+    depth, _, pose, people = golden()
     det = RgbdPeopleDetector()
-    xy, score = det.people(depth, det.pixel_scores(depth, rgb, CAMERA), CAMERA)
+    xy, score = det.people(depth, det.pixel_scores(depth, CAMERA), CAMERA)
     truth = to_base(people, pose)
     sure = xy[score >= 0.6]
     assert len(sure) == len(truth)
@@ -44,9 +44,9 @@ def test_the_shipped_detector_finds_the_people_of_the_golden_frame_and_not_the_b
 
 
 def test_candidates_carry_their_features():
-    depth, rgb, _, _ = golden()
+    depth, _, _, _ = golden()
     det = RgbdPeopleDetector()
-    xy, feats = det.candidates(depth, det.pixel_scores(depth, rgb, CAMERA), CAMERA)
+    xy, feats = det.candidates(depth, det.pixel_scores(depth, CAMERA), CAMERA)
     assert feats.shape == (len(xy), len(BLOB_FEATURES))
     f = dict(zip(BLOB_FEATURES, feats[np.argmin(np.hypot(*(xy - [3.0, 0.0]).T))], strict=True))
     # the person 3 m ahead: pixels from the floor to their head, about their body's width
