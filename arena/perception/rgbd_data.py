@@ -160,9 +160,7 @@ def sample(
     """The :class:`RgbdSample` of one frame of a robot at ``pose`` among ``people_xy``."""
     if frame.person is None:
         raise ValueError("labelled frames need the person-id pass (segmentation)")
-    n = int(np.asarray(people_xy).reshape(-1, 2).shape[0])
-    ids = frame.person[frame.person >= 0]
-    counts = np.bincount(ids, minlength=n)[:n] if ids.size else np.zeros(n, dtype=np.int64)
+    counts = frame.person_pixels(int(np.asarray(people_xy).reshape(-1, 2).shape[0]))
     depth, rgb = shrink(frame)
     c = STRIDE // 2
     h, w = depth.shape

@@ -255,11 +255,7 @@ def lidar_seen(senses: Senses) -> NDArray[np.bool_]:
 
 def camera_seen(frame: RgbdFrame, n: int) -> NDArray[np.bool_]:
     """``(n,)`` the frame shows each person (:data:`CAMERA_SEEN_FRACTION` of its pixels)."""
-    if frame.person is None:
-        return np.zeros(n, dtype=bool)
-    ids = frame.person[frame.person >= 0]
-    counts = np.bincount(ids, minlength=n)[:n] if ids.size else np.zeros(n, dtype=np.int64)
-    seen: NDArray[np.bool_] = counts >= CAMERA_SEEN_FRACTION * frame.person.size
+    seen: NDArray[np.bool_] = frame.person_pixels(n) >= CAMERA_SEEN_FRACTION * frame.depth.size
     return seen
 
 

@@ -207,3 +207,11 @@ class RgbdFrame:
     rgb: NDArray[np.uint8]
     depth: NDArray[np.float32]
     person: NDArray[np.int32] | None
+
+    def person_pixels(self, n: int) -> NDArray[np.int64]:
+        """``(n,)`` pixels showing each of people ``0 … n-1`` (zeros without segmentation)."""
+        if self.person is None:
+            return np.zeros(n, dtype=np.int64)
+        ids = self.person[self.person >= 0]
+        counts: NDArray[np.int64] = np.bincount(ids, minlength=n)[:n]
+        return counts

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import torch  # a test extra (make test installs it): this test must run, not skip
 
 from arena.perception.convnet import LAYERS, PixelNet, conv2d, torch_pixelnet
-
-torch = pytest.importorskip("torch")
 
 
 @pytest.mark.parametrize(("stride", "dilation", "k"), [(1, 1, 3), (2, 1, 3), (1, 2, 3),

@@ -16,7 +16,7 @@ from arena.robots import presets
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
 from arena.sensors import SENSORS, LidarSpec
-from arena.sensors.spec3d import Lidar3DSpec, RgbdSpec
+from arena.sensors.spec3d import Lidar3DSpec, RgbdFrame, RgbdSpec
 from arena.sim.engine import Engine
 from tests.sim.engine.helpers import driver, episodes
 
@@ -144,3 +144,14 @@ def test_lidar3d_geometry():
                                       "angle_max": 0.5})
     np.testing.assert_allclose(fan.angles(), [-0.5, 0.0, 0.5])
     np.testing.assert_allclose(fan.elevations(), [VLP.get("vertical_min", -math.radians(15))])
+
+
+def test_person_pixels_counts_each_persons_pixels():
+    person = np.full((4, 5), -1, dtype=np.int32)
+    person[0, :3] = 2
+    person[3, 4] = 0
+    frame = RgbdFrame(np.zeros((4, 5, 3), np.uint8), np.ones((4, 5), np.float32), person)
+    assert frame.person_pixels(4).tolist() == [1, 0, 3, 0]
+    assert frame.person_pixels(2).tolist() == [1, 0]  # people past n are not counted
+    blind = RgbdFrame(frame.rgb, frame.depth, None)
+    assert blind.person_pixels(3).tolist() == [0, 0, 0]
