@@ -18,6 +18,7 @@ from rich.table import Table
 from arena.cli_bench import bench, report
 from arena.cli_common import PluginOption, console, err_console, load_plugin_options
 from arena.cli_compare import compare
+from arena.cli_export import export_app
 from arena.cli_world import maps_app, scenario_app, tasks_app
 from arena.core.errors import ArenaError, ConfigError
 
@@ -66,6 +67,17 @@ def run(
             "quit",
         ),
     ] = False,
+    live: Annotated[
+        bool,
+        typer.Option("--live", help="watch and steer it in the browser: the web app's live "
+                     "view on 127.0.0.1 (pip install 'arena\\[web]')"),
+    ] = False,
+    foxglove: Annotated[
+        bool,
+        typer.Option("--foxglove", help="serve it to Foxglove: WebSocket on 127.0.0.1:8765 "
+                     "(pip install 'arena\\[web]')"),
+    ] = False,
+    port: Annotated[int, typer.Option(help="--live: the web app's port")] = 8080,
     plugin: PluginOption = None,
 ) -> None:
     """Run episodes: a robot drives to its goals among people; writes videos and trajectories.
@@ -73,7 +85,21 @@ def run(
     With ``--interactive`` the simulation runs in real time and reads one command per stdin
     line: ``goal X Y [TH]`` (new goal), ``teleport X Y [TH]`` (move the robot), ``reset`` (end
     the episode), ``quit`` (stop reading); ``robot=I`` picks another robot.
+
+    With ``--live`` (or ``--foxglove``) it runs in real time too, shown in the browser (or in
+    Foxglove): the live page pauses, steps and changes the pace, and its clicks set goals and
+    move the robot.
     """
+    from arena.cli_live import live_session
+
+    with live_session(live=live, foxglove=foxglove, web_port=port) as session:
+        _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,
+             plugin, session)
+
+
+def _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,
+         plugin, session) -> None:
+    """The body of ``arena run`` (its options as arguments, ``session`` its live setup)."""
     from rich.markup import escape
 
     from arena.config import load_config
@@ -111,15 +137,14 @@ def run(
         block = json.dumps({"type": "scenario", "file": str(file)})
         items += [f"task.robots={block}", f"task.obstacles={block}"]
     cfg = load_config(path, items)
-    extra_modules = []
+    extra_modules = list(session.modules)  # a live view's goals and teleports
     if interactive:
         from arena.tasks.modules.interactive import InteractiveModule
 
-        ui = InteractiveModule(
-            on_error=lambda msg: err_console.print(f"error: {msg}", highlight=False)
-        )
-        extra_modules.append(ui)
-        _read_commands(ui)
+        if not extra_modules:
+            extra_modules.append(InteractiveModule(
+                on_error=lambda msg: err_console.print(f"error: {msg}", highlight=False)))
+        _read_commands(extra_modules[0])
 
     table = Table(title=f"arena run · {run_name(cfg)}", show_lines=False)
     for col in ("episode", "outcome", "time [s]", "path [m]", "collisions", "wall [s]"):
@@ -153,8 +178,9 @@ def run(
     bar, on_step = episode_progress(console, enabled=console.is_terminal and not interactive)
     with bar:
         out_dir, results = run_experiment(
-            cfg, out, on_episode=show, modules=extra_modules, realtime=interactive,
-            on_step=on_step,
+            cfg, out, on_episode=show, modules=extra_modules,
+            realtime=interactive and not session.hooks,  # a live view paces the run itself
+            on_step=on_step, hooks=session.hooks, on_start=session.on_start,
         )
     console.print(table)
     console.print(f"results:     {out_dir}/summary.csv", soft_wrap=True)
@@ -241,6 +267,7 @@ def plugins(
 app.add_typer(maps_app, name="maps")
 app.add_typer(scenario_app, name="scenario")
 app.add_typer(tasks_app, name="tasks")
+app.add_typer(export_app, name="export")
 app.command()(bench)
 
 

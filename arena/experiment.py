@@ -34,7 +34,7 @@ import arena.plugins  # noqa: F401  (fills the registries)
 from arena.config.names import UNNAMED, run_name
 from arena.config.schema import ExperimentConfig
 from arena.core.files import make_dir
-from arena.episode.runner import describe_exception
+from arena.episode.runner import EpisodeHooks, describe_exception
 from arena.eval.episodes import EpisodeResult, episode_metrics, failed_result, run_episode
 from arena.robots.model import RobotModel
 from arena.robots.presets import load_robot
@@ -88,6 +88,8 @@ def run_experiment(
     modules: Sequence[Any] = (),
     realtime: bool = False,
     on_step: Callable[[int, float, float], None] | None = None,
+    hooks: Sequence[EpisodeHooks] = (),
+    on_start: Callable[[Path], None] | None = None,
 ) -> tuple[Path, list[EpisodeResult]]:
     """Run every episode of ``cfg`` and write the outputs under ``out_dir``.
 
@@ -99,6 +101,8 @@ def run_experiment(
             module, which it feeds from stdin).
         realtime: pace the simulation to wall-clock time (interactive runs).
         on_step: ``on_step(episode, time, time_limit)`` after each simulated step (s).
+        hooks: extra episode hooks of every episode (the live view).
+        on_start: called with the output folder once it exists, before the first episode.
 
     ``summary.csv`` has one row per episode: its figures, then every registered metric
     (:func:`episode_metrics`, the values ``arena bench`` stores).
@@ -113,6 +117,8 @@ def run_experiment(
     out = make_dir(Path(out_dir or cfg.output.dir or default_output_dir(cfg)),
                    what="output folder (output.dir, -o)")
     (out / "config.yaml").write_text(yaml.safe_dump(cfg.model_dump(mode="json"), sort_keys=False))
+    if on_start is not None:
+        on_start(out)
     results: list[EpisodeResult] = []
     for i in range(n_episodes):
         episode = first if i == 0 else generator.episode(i)
@@ -128,6 +134,7 @@ def run_experiment(
                 runtime=generator.runtime(episode),
                 realtime=realtime,
                 on_step=None if on_step is None else functools.partial(on_step, i),
+                hooks=hooks,
             )
         except Exception as e:  # raised outside the step loop (a planner's constructor ...)
             res = failed_result(cfg, episode, describe_exception(e), time.perf_counter() - t0)

@@ -103,6 +103,7 @@ class EpisodeRunner:
     Attributes:
         state: the current snapshot.
         episode: the running episode.
+        crowd: the pedestrian driver it was reset with (``None``: the backend's default).
         outcome: ``None`` while the episode runs, then how it ended.
         error: one line on the exception that ended it ("" if none).
         exception: that exception, or ``None``.
@@ -127,6 +128,7 @@ class EpisodeRunner:
         self.substeps = int(substeps)
         self.episode: Episode | None = None
         self.state: SimState | None = None
+        self.crowd: PedestrianDriver | None = None
         self.outcome: Outcome | None = None
         self.error = ""
         self.exception: BaseException | None = None
@@ -145,7 +147,7 @@ class EpisodeRunner:
         episode of ``arena run``, ``arena bench`` and the learning env with the same seed and
         index are the same. A hook raising here ends the episode at once (see the module doc).
         """
-        self.episode = episode
+        self.episode, self.crowd = episode, crowd
         self.state = self.backend.reset(
             episode, crowd, derive_rng(seed, "episode", episode.index, "sim")
         )

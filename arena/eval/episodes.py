@@ -108,6 +108,7 @@ def run_episode(
     runtime: TaskRuntime | None = None,
     realtime: bool = False,
     on_step: Callable[[float, float], None] | None = None,
+    hooks: Sequence[EpisodeHooks] = (),
 ) -> EpisodeResult:
     """Simulate one episode with the configured navigation stack and write its files.
 
@@ -117,7 +118,8 @@ def run_episode(
     ``teleport``, the stack plans afresh), new goals make the stack replan, and a forced reset
     ends the episode as ``aborted``. ``realtime`` paces the loop to ``dt`` of wall time per
     step (interactive runs). ``on_step(time, time_limit)`` (both s) is called after each
-    simulated step (progress displays).
+    simulated step (progress displays). ``hooks`` run after the episode's own (the live view's
+    :class:`~arena.live.hook.LiveHook`): they see the navigation controller's goal and plan.
 
     The stack's goal tolerances follow the episode: position within ``0.9 · goal_radius`` (or
     the navigation config's, if smaller) and, when the task checks the heading
@@ -145,12 +147,12 @@ def run_episode(
     frames = _Frames(nav) if video else None
     # recorder and frames first: they keep the first state even when planning fails at once;
     # the contact counter after the controller: it sees the tick's teleports
-    hooks: list[EpisodeHooks] = [recorder, *([frames] if frames else []), nav, contacts]
+    own: list[EpisodeHooks] = [recorder, *([frames] if frames else []), nav, contacts]
     if realtime:
-        hooks.append(_Pacer())
+        own.append(_Pacer())
     if on_step is not None:
-        hooks.append(_Progress(on_step))
-    runner = EpisodeRunner(backend, dt, hooks, nav)
+        own.append(_Progress(on_step))
+    runner = EpisodeRunner(backend, dt, [*own, *hooks], nav)
     crowd = build_driver(cfg.crowd, cfg.pedestrians)
     runner.reset(episode, crowd, seed)
     outcome = runner.run()

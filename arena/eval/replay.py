@@ -12,14 +12,20 @@ for a run.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from arena.eval import plots
 from arena.eval.io import load_record
+from arena.eval.record import EpisodeRecord
+
+if TYPE_CHECKING:
+    from arena.episode.runner import EpisodeHooks
+    from arena.eval.episodes import EpisodeResult
 
 
 @dataclass(frozen=True)
@@ -64,6 +70,45 @@ def pick_episodes(table: Any, count: int = 1) -> list[tuple[str, int]]:
     return ranked[: max(0, count)]
 
 
+def resimulate(
+    record: EpisodeRecord, out_dir: Path | None = None, *, video: bool = False,
+    hooks: Sequence[EpisodeHooks] = (), config: dict[str, Any] | None = None,
+) -> tuple[EpisodeResult, bool]:
+    """Simulate a recorded episode again from the config in its record.
+
+    Args:
+        record: the recorded episode (its meta holds the resolved config, seed and index).
+        out_dir: where the new episode writes its files (``None``: nowhere).
+        video: render its video (into ``out_dir``).
+        hooks: extra episode hooks (a Foxglove sink's :class:`~arena.live.hook.LiveHook`).
+        config: the config to use instead of the record's (the record's with changed output
+            options); the counterfactual replay is always off.
+
+    Returns:
+        The new result and whether its trajectory equals the recorded one (it should, always:
+        ``False`` means the run is not reproducible).
+    """
+    import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
+    from arena.config.schema import ExperimentConfig
+    from arena.eval.episodes import run_episode
+    from arena.robots.presets import load_robot
+    from arena.sim.backend import BACKENDS
+    from arena.tasks.generator import TaskGenerator
+
+    data = dict(config if config is not None else record.meta.config)
+    data["evaluation"] = {**data.get("evaluation", {}), "counterfactual": False}
+    cfg = ExperimentConfig.model_validate(data)
+    gen = TaskGenerator.from_config(cfg, [load_robot(cfg.robot)])
+    episode = gen.episode(record.meta.episode)
+    backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
+    res = run_episode(cfg, episode, backend, out_dir, video=video,
+                      runtime=gen.runtime(episode), hooks=hooks)
+    again = res.record
+    same = (again is not None and again.pose.shape == record.pose.shape
+            and bool(np.array_equal(again.pose, record.pose)))
+    return res, same
+
+
 def render_episode_video(
     record_path: str | Path, out_dir: str | Path, *, caption: str | None = None,
     width_px: int | None = None, frame_every: int = 2,
@@ -81,28 +126,12 @@ def render_episode_video(
     Returns:
         The video and whether the new trajectory equals the recorded one.
     """
-    import arena.plugins  # noqa: F401  (fills the registries in a fresh worker)
-    from arena.config.schema import ExperimentConfig
-    from arena.eval.episodes import run_episode
-    from arena.robots.presets import load_robot
-    from arena.sim.backend import BACKENDS
-    from arena.tasks.generator import TaskGenerator
-
     record = load_record(record_path)
     data = dict(record.meta.config)
     size = {} if width_px is None else {"width_px": width_px}
     data["output"] = {**data.get("output", {}), **size,
                       "frame_every": frame_every, "video_format": "mp4"}
-    data["evaluation"] = {**data.get("evaluation", {}), "counterfactual": False}
-    cfg = ExperimentConfig.model_validate(data)
-    gen = TaskGenerator.from_config(cfg, [load_robot(cfg.robot)])
-    episode = gen.episode(record.meta.episode)
-    backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
-    res = run_episode(cfg, episode, backend, Path(out_dir), video=True,
-                      runtime=gen.runtime(episode))
-    again = res.record
-    same = (again is not None and again.pose.shape == record.pose.shape
-            and bool(np.array_equal(again.pose, record.pose)))
+    res, same = resimulate(record, Path(out_dir), video=True, config=data)
     if caption is None:
         caption = (f"{record.meta.stage or record.meta.map_name} · "
                    f"episode {record.meta.episode} · {record.meta.outcome}")
