@@ -92,7 +92,9 @@ def run(
     """
     from arena.cli_live import live_session
 
-    with live_session(live=live, foxglove=foxglove, web_port=port) as session:
+    # a browser opens only for someone at a terminal (not in scripts and tests)
+    with live_session(live=live, foxglove=foxglove, web_port=port,
+                      open_browser=sys.stdout.isatty()) as session:
         _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,
              plugin, session)
 
@@ -360,6 +362,29 @@ def train(
 
 app.command()(report)
 app.command()(compare)
+
+
+@app.command()
+def web(
+    root: Annotated[Path, typer.Option(help="the run store: the folder of the run folders")] = Path(
+        "runs"),
+    host: Annotated[str, typer.Option(help="interface (anything but loopback needs a token)")
+                    ] = "127.0.0.1",
+    port: Annotated[int, typer.Option(help="TCP port")] = 8080,
+    token: Annotated[
+        str | None,
+        typer.Option(help="what every request must carry (default: none on 127.0.0.1, a new "
+                          "one elsewhere)"),
+    ] = None,
+) -> None:
+    r"""The web app: runs, results, replays and live views (pip install 'arena\[web]')."""
+    try:
+        from arena.web.server import serve
+    except ImportError:
+        raise ConfigError("arena web needs the web extra: pip install 'arena[web]'") from None
+    root.mkdir(parents=True, exist_ok=True)
+    serve(root, host=host, port=port, token=token,
+          announce=lambda text: console.print(text, highlight=False, soft_wrap=True))
 
 
 def main() -> None:

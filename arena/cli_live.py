@@ -68,7 +68,7 @@ def live_session(
             console.print(f"foxglove:    ws://127.0.0.1:{server.port} (open it in Foxglove: "
                           "Open connection → Foxglove WebSocket)", highlight=False)
         if live:
-            from arena.web.server import serve_in_thread
+            from arena.web.server import serve_subprocess
 
             channel = LiveServer(control=control)
             stack.callback(channel.close)
@@ -77,7 +77,7 @@ def live_session(
             def started(out: Path) -> None:
                 info = channel.write_info(out)
                 stack.callback(lambda: info.unlink(missing_ok=True))
-                web = serve_in_thread(out.parent, port=web_port)
+                web = serve_subprocess(out.parent, port=web_port)
                 stack.callback(web.stop)
                 session.url = f"{web.url}/live/{out.name}"
                 console.print(f"live view:   {session.url}", highlight=False, soft_wrap=True)

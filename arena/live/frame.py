@@ -23,6 +23,8 @@ from numpy.typing import NDArray
 
 from arena.crowd.state import SocialState
 from arena.maps.grid import OccupancyGrid
+from arena.render import style
+from arena.render.style import agent_state_color
 from arena.scene.state import AgentStates
 from arena.sensors.spec import LidarSpec, lidar_geometry
 
@@ -182,6 +184,10 @@ def _mm(a: Any) -> Any:
     return np.round(np.asarray(a, dtype=np.float64), 3).tolist()
 
 
+def _hex(rgb: tuple[float, float, float]) -> str:
+    return "#" + "".join(f"{round(255 * c):02x}" for c in rgb)
+
+
 def grid_png(grid: OccupancyGrid) -> bytes:
     """The grid as a greyscale PNG, north up (free white, occupied black, unknown grey)."""
     from PIL import Image
@@ -207,6 +213,11 @@ def scene_json(scene: LiveScene) -> dict[str, Any]:
         "robots": [{"name": n, "model": m, "footprint": _mm(fp)} for n, m, fp in
                    zip(scene.robot_names, scene.robot_models, scene.footprints, strict=True)],
         "states": [s.name.lower() for s in SocialState],
+        # the videos' colours, so a live view and a video read alike
+        "state_colors": [_hex(agent_state_color(s)) for s in SocialState],
+        "kind_colors": [_hex(c) for c in style.AGENT_KIND_COLORS],
+        "robot_colors": [_hex(style.robot_color(i)) for i in range(len(scene.robot_names))],
+        "collision_color": _hex(style.COLLISION),
     }
 
 

@@ -1,0 +1,172 @@
+"""The web app's pages (NiceGUI): the run list, a run's results, the live view and the replay.
+
+Pages read the store through the same :class:`~arena.web.store.RunStore` as the API; the live
+and replay canvases are ``static/arena_view.js``, fed by the API (``/api/runs/{run}/live`` and
+``/api/runs/{run}/replay``). Everything a page shows from a run's files is HTML-escaped.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+from datetime import datetime
+from typing import Any
+from urllib.parse import quote
+
+from nicegui import ui
+
+from arena.web.store import NotFound, RunStore
+
+#: The store the pages show (set by :func:`arena.web.server.create_app`).
+STORE: RunStore | None = None
+
+#: Speeds the live view offers (multiples of real time; 0: as fast as it goes).
+SPEEDS = {"¼×": 0.25, "½×": 0.5, "1×": 1.0, "2×": 2.0, "4×": 4.0, "8×": 8.0, "max": 0.0}
+#: Result columns shown first, when a run has them.
+COLUMNS = ("contestant", "stage", "episode", "index", "map", "outcome", "time", "path_length",
+           "collisions", "success", "min_distance_to_person")
+
+SCRIPT = '<script src="/static/arena_view.js"></script>'
+CANVAS = ('<canvas id="arena-canvas" style="width:100%;height:72vh;display:block;'
+          'border-radius:6px"></canvas>')
+
+
+def _store() -> RunStore:
+    assert STORE is not None, "create_app sets the store"
+    return STORE
+
+
+def _header(title: str) -> None:
+    ui.page_title(f"{title} · Arena")
+    with ui.header().classes("items-center bg-slate-800"):
+        ui.link("Arena", "/").classes("text-white text-lg font-bold no-underline")
+        ui.label(title).classes("text-slate-200")
+        ui.space()
+        ui.link("API", "/docs").classes("text-slate-300")
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, float):
+        return "–" if not math.isfinite(value) else f"{value:.3g}"
+    return html.escape(str(value))
+
+
+@ui.page("/")
+def index() -> None:
+    """Every run of the store, newest first, with links to its results and live view."""
+    _header("runs")
+    runs = _store().runs()
+    if not runs:
+        ui.label(f"No runs in {_store().root} yet: start one with arena run or arena bench.")
+        return
+    rows = []
+    for r in runs:
+        name = quote(r.name)
+        live = f' · <a href="/live/{name}">live</a>' if r.live else ""
+        when = datetime.fromtimestamp(r.modified).strftime("%Y-%m-%d %H:%M")
+        rows.append(f'<tr><td><a href="/runs/{name}">{html.escape(r.name)}</a>{live}</td>'
+                    f"<td>{r.kind}</td><td>{html.escape(r.title)}</td><td>{r.episodes}</td>"
+                    f"<td>{when}</td></tr>")
+    ui.html('<table class="arena-table"><tr><th>run</th><th>kind</th><th>what</th>'
+            "<th>episodes</th><th>modified</th></tr>" + "".join(rows) + "</table>",
+            sanitize=False)
+    _table_style()
+
+
+def _table_style() -> None:
+    ui.add_css(".arena-table{border-collapse:collapse;font-size:14px}"
+               ".arena-table td,.arena-table th{padding:4px 10px;border-bottom:1px solid #ddd;"
+               "text-align:left}")
+
+
+@ui.page("/runs/{run}")
+def results(run: str) -> None:
+    """A run's episodes with their figures and a replay link each."""
+    _header(run)
+    try:
+        info = _store().info(run)
+        rows = _store().results(run)
+    except NotFound as e:
+        ui.label(str(e)).classes("text-red-700")
+        return
+    if info.live:
+        ui.link("watch it live", f"/live/{quote(run)}")
+    if not rows:
+        ui.label("No finished episode yet.")
+        return
+    cols = [c for c in COLUMNS if c in rows[0]]
+    head = "".join(f"<th>{c}</th>" for c in cols) + "<th></th>"
+    body = []
+    for row in rows:
+        rec = str(row.get("record") or "")
+        link = (f'<a href="/replay/{quote(run)}?record={quote(rec)}">replay</a>'
+                if rec.endswith(".parquet") else "")
+        body.append("<tr>" + "".join(f"<td>{_cell(row.get(c, ''))}</td>" for c in cols)
+                    + f"<td>{link}</td></tr>")
+    ui.html(f'<table class="arena-table"><tr>{head}</tr>{"".join(body)}</table>',
+            sanitize=False)
+    _table_style()
+
+
+@ui.page("/live/{run}")
+async def live(run: str) -> None:
+    """The live view: canvas, pause/step/speed, and goal or teleport by clicking."""
+    _header(f"{run} · live")
+    try:
+        _store().folder(run)
+    except NotFound as e:
+        ui.label(str(e)).classes("text-red-700")
+        return
+    ui.add_head_html(SCRIPT)
+    with ui.row().classes("items-center gap-2"):
+        ui.button("pause", on_click=lambda: _send({"cmd": "pause"})).props("id=arena-pause")
+        ui.button("resume", on_click=lambda: _send({"cmd": "resume"})).props("id=arena-resume")
+        ui.button("step", on_click=lambda: _send({"cmd": "step"})).props("id=arena-step")
+        ui.toggle(list(SPEEDS), value="1×",
+                  on_change=lambda e: _send({"cmd": "speed", "value": SPEEDS[e.value]}))
+        ui.label("click:")
+        ui.toggle({"": "look", "goal": "set goal", "teleport": "move robot"}, value="",
+                  on_change=lambda e: ui.run_javascript(
+                      f"window.arenaView.tool = {json.dumps(e.value or None)}"))
+    ui.html('<div id="arena-status" style="font-family:monospace;font-size:13px">connecting'
+            "…</div>" + CANVAS, sanitize=False).classes("w-full")
+    await ui.context.client.connected()
+    ui.run_javascript(
+        "window.arenaView = new ArenaView(document.getElementById('arena-canvas'));"
+        "window.arenaLive = new ArenaLive(window.arenaView, "
+        "(location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + "
+        f"'/api/runs/' + {json.dumps(quote(run))} + '/live', arenaShowStatus);")
+
+
+def _send(message: dict[str, Any]) -> None:
+    ui.run_javascript(f"window.arenaLive && window.arenaLive.send({json.dumps(message)})")
+
+
+@ui.page("/replay/{run}")
+async def replay(run: str, record: str = "") -> None:
+    """One recorded episode, simulated again, on the canvas with a time slider."""
+    _header(f"{run} · replay")
+    try:
+        _store().file(run, record)
+    except NotFound as e:
+        ui.label(str(e)).classes("text-red-700")
+        return
+    ui.add_head_html(SCRIPT)
+    with ui.row().classes("items-center gap-2"):
+        ui.button("play", on_click=lambda: ui.run_javascript("window.arenaReplay.play()")
+                  ).props("id=arena-play")
+        ui.button("pause", on_click=lambda: ui.run_javascript("window.arenaReplay.pause()"))
+        ui.label(record).classes("text-slate-500")
+    ui.html('<div style="display:flex;gap:12px;align-items:center">'
+            '<input id="arena-slider" type="range" min="0" max="0" value="0" '
+            'style="flex:1"><span id="arena-time" style="font-family:monospace">loading…'
+            "</span></div>" + CANVAS, sanitize=False).classes("w-full")
+    await ui.context.client.connected()
+    url = f"/api/runs/{quote(run)}/replay?record={quote(record)}"
+    ui.run_javascript(
+        "window.arenaView = new ArenaView(document.getElementById('arena-canvas'));"
+        f"fetch({json.dumps(url)}).then(r => r.json()).then(d => {{"
+        "  window.arenaReplay = new ArenaReplay(window.arenaView, d,"
+        "    document.getElementById('arena-slider'), document.getElementById('arena-time'));"
+        "});")
