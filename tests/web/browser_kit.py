@@ -37,7 +37,7 @@ def browser_page(width: int = 1280, height: int = 900) -> Iterator[Any]:
         browser = p.chromium.launch(executable_path=exe, args=["--no-sandbox"])
         try:
             page = browser.new_page(viewport={"width": width, "height": height})
-            page.set_default_timeout(30_000)
+            page.set_default_timeout(90_000)
             yield page
         finally:
             browser.close()

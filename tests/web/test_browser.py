@@ -114,13 +114,14 @@ def test_results_and_replay(live_run):
     url, root = live_run
     base = url.split("/live/")[0]
     done = root / "watched" / "episode_000" / "episode.json"
-    _wait(done.is_file, timeout=120, what="the first episode")
+    summary = root / "watched" / "summary.csv"  # written after the episode's own files
+    _wait(summary.is_file, timeout=120, what="the first episode")
     with browser_page() as page:
         page.goto(f"{base}/")
         page.get_by_text("watched").first.click()
         page.get_by_text("replay").first.click()
         _wait(lambda: page.evaluate("window.arenaReplay ? window.arenaReplay.frames.length : 0"),
-              what="the replay")
+              timeout=120, what="the replay")  # simulated again on a loaded machine
         steps = json.loads(done.read_text())["steps"]
         assert page.evaluate("window.arenaReplay.frames.length") == steps + 1
         page.fill("#arena-slider", str(steps // 2))
