@@ -161,6 +161,8 @@ class LiveServer:
             self._frame = line
             for c in self._clients:
                 if c.authorized:
+                    if last:
+                        c.latest = None  # an older frame must not arrive after the last one
                     c.send(line, reliable=last)
                     self.frames_sent += 1
 
