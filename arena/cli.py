@@ -378,10 +378,8 @@ def web(
     ] = None,
 ) -> None:
     r"""The web app: runs, results, replays and live views (pip install 'arena\[web]')."""
-    try:
-        from arena.web.server import serve
-    except ImportError:
-        raise ConfigError("arena web needs the web extra: pip install 'arena[web]'") from None
+    from arena.web.server import serve
+
     root.mkdir(parents=True, exist_ok=True)
     serve(root, host=host, port=port, token=token,
           announce=lambda text: console.print(text, highlight=False, soft_wrap=True))

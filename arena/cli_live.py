@@ -68,7 +68,9 @@ def live_session(
             console.print(f"foxglove:    ws://127.0.0.1:{server.port} (open it in Foxglove: "
                           "Open connection → Foxglove WebSocket)", highlight=False)
         if live:
-            from arena.web.server import serve_subprocess
+            from arena.web.server import require_web, serve_subprocess
+
+            require_web()  # before the run starts, not when its folder exists
 
             channel = LiveServer(control=control)
             stack.callback(channel.close)

@@ -90,6 +90,16 @@ class TokenGate:
         await self.app(scope, receive, send_with_cookie)
 
 
+def require_web() -> None:
+    """Raise a one-line :class:`ConfigError` naming the extra when the web packages are missing."""
+    try:
+        import fastapi  # noqa: F401
+        import nicegui  # noqa: F401
+        import uvicorn  # noqa: F401
+    except ImportError:
+        raise ConfigError("the web app needs the web extra: pip install 'arena[web]'") from None
+
+
 def create_app(root: str | Path, *, token: str | None = None, pages: bool = True) -> Any:
     """The app on the run store ``root``.
 
@@ -134,6 +144,7 @@ def check_host(host: str, token: str | None) -> str | None:
 def serve(root: str | Path, *, host: str = "127.0.0.1", port: int = 8080,
           token: str | None = None, announce: Any = print) -> None:
     """Serve the app until interrupted (what ``arena web`` does)."""
+    require_web()
     import uvicorn
 
     token = check_host(host, token)
@@ -160,6 +171,8 @@ class WebProcess:
 
     process: subprocess.Popen[bytes]
     url: str
+    log: Any = None
+    """The open log file the process writes to (closed by :meth:`stop`), or ``None``."""
 
     def stop(self, timeout: float = 10.0) -> None:
         """Stop the server (terminate, then kill after ``timeout`` s)."""
@@ -170,6 +183,8 @@ class WebProcess:
             except subprocess.TimeoutExpired:
                 self.process.kill()
                 self.process.wait(timeout)
+        if self.log is not None:
+            self.log.close()
 
 
 def serve_subprocess(root: str | Path, *, port: int = 8080, timeout: float = 60.0,
@@ -181,15 +196,17 @@ def serve_subprocess(root: str | Path, *, port: int = 8080, timeout: float = 60.
     Raises:
         ConfigError: the server did not answer in time (its log says why).
     """
+    require_web()
     port = free_port(port)
-    out = open(log, "wb") if log is not None else subprocess.DEVNULL  # noqa: SIM115
+    out = open(log, "wb") if log is not None else subprocess.DEVNULL  # noqa: SIM115 (stop closes it)
     cmd = [sys.executable, "-m", "arena.cli", "web", "--root", str(root), "--port", str(port)]
     proc = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT,
                             env={**os.environ, "PYTHONUNBUFFERED": "1"})
-    web = WebProcess(proc, f"http://127.0.0.1:{port}")
+    web = WebProcess(proc, f"http://127.0.0.1:{port}", out if log is not None else None)
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         if proc.poll() is not None:
+            web.stop()
             raise ConfigError(f"arena web stopped at once (exit {proc.returncode})"
                               + (f"; see {log}" if log else ""))
         with socket.socket() as s:

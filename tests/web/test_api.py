@@ -159,3 +159,17 @@ def test_hosts_other_than_loopback_need_a_token():
     assert check_host("127.0.0.1", None) is None
     assert check_host("0.0.0.0", None)  # a generated one
     assert check_host("0.0.0.0", "mine") == "mine"
+
+
+def test_missing_web_extra_is_one_line(monkeypatch, capsys, tmp_path):
+    import sys
+
+    from tests.cli_kit import run_cli
+
+    monkeypatch.setitem(sys.modules, "nicegui", None)  # as if not installed
+    code, _, err = run_cli(monkeypatch, capsys, "web", "--root", str(tmp_path))
+    assert code == 2 and err.count("\n") == 1 and "pip install 'arena[web]'" in err
+    code, _, err = run_cli(monkeypatch, capsys, "run", "-n", "1", "--no-video", "--live",
+                           "-o", str(tmp_path / "r"))
+    assert code == 2 and "pip install 'arena[web]'" in err
+    assert not (tmp_path / "r").exists()  # refused before the run began
