@@ -6,6 +6,7 @@ with status 2; no traceback. ``ARENA_DEBUG=1`` shows the traceback anyway.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import sys
 import warnings
@@ -97,6 +98,14 @@ def run(
                       open_browser=sys.stdout.isatty()) as session:
         _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,
              plugin, session)
+        if session.url and sys.stdin.isatty():  # someone watches: keep the pages up for them
+            import threading
+
+            results = session.url.replace("/live/", "/runs/")
+            console.print(f"the run is over; its results stay at {results} until Ctrl+C",
+                          highlight=False, soft_wrap=True)
+            with contextlib.suppress(KeyboardInterrupt):
+                threading.Event().wait()
 
 
 def _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,

@@ -53,6 +53,7 @@ class LiveControl:
         self._closed = False
         self._speed = self._checked_speed(speed)
         self._anchor: tuple[float, float] | None = None  # (wall s, sim s) the pace counts from
+        self._last_time = 0.0  # the last tick's sim time (s): a smaller one starts an episode
         self.listeners: list[Callable[[dict[str, Any]], None]] = []
         """Called with :meth:`status` after every change (the live server tells its viewers)."""
 
@@ -178,8 +179,9 @@ class LiveControl:
             if self._speed == 0:
                 return
             now = self._clock()
-            if self._anchor is None:
-                self._anchor = (now, sim_time)
+            if self._anchor is None or sim_time < self._last_time:
+                self._anchor = (now, sim_time)  # the first tick, or a new episode's clock
+            self._last_time = sim_time
             ahead = self._anchor[0] + (sim_time - self._anchor[1]) / self._speed - now
         if ahead > 0:
             self._sleep(ahead)

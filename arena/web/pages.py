@@ -110,7 +110,7 @@ def results(run: str) -> None:
 
 
 @ui.page("/live/{run}")
-async def live(run: str) -> None:
+def live(run: str) -> None:
     """The live view: canvas, pause/step/speed, and goal or teleport by clicking."""
     _header(f"{run} · live")
     try:
@@ -120,9 +120,10 @@ async def live(run: str) -> None:
         return
     ui.add_head_html(SCRIPT)
     with ui.row().classes("items-center gap-2"):
-        ui.button("pause", on_click=lambda: _send({"cmd": "pause"})).props("id=arena-pause")
-        ui.button("resume", on_click=lambda: _send({"cmd": "resume"})).props("id=arena-resume")
-        ui.button("step", on_click=lambda: _send({"cmd": "step"})).props("id=arena-step")
+        # the buttons talk to the run's WebSocket from the browser (no round trip here)
+        for name, message in (("pause", {"cmd": "pause"}), ("resume", {"cmd": "resume"}),
+                              ("step", {"cmd": "step"})):
+            ui.button(name).props(f"id=arena-{name}").on("click", js_handler=_send_js(message))
         ui.toggle(list(SPEEDS), value="1×",
                   on_change=lambda e: _send({"cmd": "speed", "value": SPEEDS[e.value]}))
         ui.label("click:")
@@ -131,12 +132,16 @@ async def live(run: str) -> None:
                       f"window.arenaView.tool = {json.dumps(e.value or None)}"))
     ui.html('<div id="arena-status" style="font-family:monospace;font-size:13px">connecting'
             "…</div>" + CANVAS, sanitize=False).classes("w-full")
-    await ui.context.client.connected()
-    ui.run_javascript(
-        "window.arenaView = new ArenaView(document.getElementById('arena-canvas'));"
-        "window.arenaLive = new ArenaLive(window.arenaView, "
-        "(location.protocol === 'https:' ? 'wss://' : 'ws://') + location.host + "
-        f"'/api/runs/' + {json.dumps(quote(run))} + '/live', arenaShowStatus);")
+    ui.add_body_html(f"<script>arenaStartLive({_js(run)});</script>")
+
+
+def _js(value: Any) -> str:
+    """``value`` as a JavaScript literal safe inside a ``<script>`` element."""
+    return json.dumps(value).replace("<", "\\u003c").replace(">", "\\u003e")
+
+
+def _send_js(message: dict[str, Any]) -> str:
+    return f"() => window.arenaLive && window.arenaLive.send({json.dumps(message)})"
 
 
 def _send(message: dict[str, Any]) -> None:
@@ -144,7 +149,7 @@ def _send(message: dict[str, Any]) -> None:
 
 
 @ui.page("/replay/{run}")
-async def replay(run: str, record: str = "") -> None:
+def replay(run: str, record: str = "") -> None:
     """One recorded episode, simulated again, on the canvas with a time slider."""
     _header(f"{run} · replay")
     try:
@@ -154,19 +159,13 @@ async def replay(run: str, record: str = "") -> None:
         return
     ui.add_head_html(SCRIPT)
     with ui.row().classes("items-center gap-2"):
-        ui.button("play", on_click=lambda: ui.run_javascript("window.arenaReplay.play()")
-                  ).props("id=arena-play")
-        ui.button("pause", on_click=lambda: ui.run_javascript("window.arenaReplay.pause()"))
+        ui.button("play").props("id=arena-play").on(
+            "click", js_handler="() => window.arenaReplay && window.arenaReplay.play()")
+        ui.button("pause").on(
+            "click", js_handler="() => window.arenaReplay && window.arenaReplay.pause()")
         ui.label(record).classes("text-slate-500")
     ui.html('<div style="display:flex;gap:12px;align-items:center">'
             '<input id="arena-slider" type="range" min="0" max="0" value="0" '
             'style="flex:1"><span id="arena-time" style="font-family:monospace">loading…'
             "</span></div>" + CANVAS, sanitize=False).classes("w-full")
-    await ui.context.client.connected()
-    url = f"/api/runs/{quote(run)}/replay?record={quote(record)}"
-    ui.run_javascript(
-        "window.arenaView = new ArenaView(document.getElementById('arena-canvas'));"
-        f"fetch({json.dumps(url)}).then(r => r.json()).then(d => {{"
-        "  window.arenaReplay = new ArenaReplay(window.arenaView, d,"
-        "    document.getElementById('arena-slider'), document.getElementById('arena-time'));"
-        "});")
+    ui.add_body_html(f"<script>arenaStartReplay({_js(run)}, {_js(record)});</script>")

@@ -137,6 +137,17 @@ def test_control_paces_to_the_speed():
         ctl.apply({"cmd": "goal", "x": 1.0, "y": 2.0})
 
 
+def test_a_new_episode_is_paced_from_its_own_start():
+    clock = FakeClock()
+    ctl = LiveControl(speed=1.0, clock=clock, sleep=clock.sleep)
+    for t in (0.0, 1.0, 2.0):  # episode 0: 2 s at real time
+        ctl.wait(t)
+    clock.now += 3.0  # the episode's end and the next one's set-up take wall time
+    ctl.wait(0.0)  # episode 1's clock starts again at 0
+    ctl.wait(1.0)  # ... and its first second takes one second, not none
+    assert clock.slept == [pytest.approx(1.0)] * 3
+
+
 def test_pause_holds_the_tick_and_steps_release_one():
     ctl = LiveControl(speed=0)
     statuses = []

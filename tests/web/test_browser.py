@@ -39,10 +39,13 @@ def _wait(predicate, timeout: float = 30.0, what: str = "condition"):
 
 @pytest.fixture
 def live_run(tmp_path):
-    """``arena run --live`` in its own process (2 episodes at real time); its live URL."""
+    """``arena run --live`` in its own process (episodes at real time); its live URL.
+
+    It has more episodes than a test watches: its web app stops with the run.
+    """
     chromium_path()
     port = free_port(8300 + os.getpid() % 500)
-    cmd = [sys.executable, "-m", "arena.cli", "run", "-n", "2", "--no-video", "--seed", "4",
+    cmd = [sys.executable, "-m", "arena.cli", "run", "-n", "20", "--no-video", "--seed", "4",
            "--live", "--port", str(port), "-o", str(tmp_path / "runs" / "watched")]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                             start_new_session=True)
@@ -120,8 +123,14 @@ def test_results_and_replay(live_run):
         page.goto(f"{base}/")
         page.get_by_text("watched").first.click()
         page.get_by_text("replay").first.click()
-        _wait(lambda: page.evaluate("window.arenaReplay ? window.arenaReplay.frames.length : 0"),
-              timeout=120, what="the replay")  # simulated again on a loaded machine
+        try:
+            _wait(lambda: page.evaluate(
+                "window.arenaReplay ? window.arenaReplay.frames.length : window.arenaReplayError"
+                " ? -1 : 0"), timeout=120, what="the replay")  # simulated again: a loaded machine
+        except AssertionError:
+            raise AssertionError(f"no replay at {page.url}: {page.inner_text('body')[-400:]}"
+                                 ) from None
+        assert page.evaluate("window.arenaReplayError || null") is None, page.inner_text("body")
         steps = json.loads(done.read_text())["steps"]
         assert page.evaluate("window.arenaReplay.frames.length") == steps + 1
         page.fill("#arena-slider", str(steps // 2))

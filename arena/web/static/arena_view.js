@@ -387,6 +387,44 @@ function arenaShowStatus(m) {
 }
 setInterval(() => { if (window.arenaLive) arenaShowStatus({ type: "tick" }); }, 250);
 
+// Run fn once the element with this id exists (NiceGUI mounts the page after the body's
+// scripts run); the pages start their canvas this way, without a server round trip.
+function arenaWhenReady(id, fn) {
+  const el = document.getElementById(id);
+  if (el) fn(el);
+  else setTimeout(() => arenaWhenReady(id, fn), 20);
+}
+
+// The live page: the canvas fed by the run's live WebSocket.
+function arenaStartLive(run) {
+  arenaWhenReady("arena-canvas", (canvas) => {
+    window.arenaView = new ArenaView(canvas);
+    const scheme = location.protocol === "https:" ? "wss://" : "ws://";
+    window.arenaLive = new ArenaLive(window.arenaView,
+      scheme + location.host + "/api/runs/" + encodeURIComponent(run) + "/live", arenaShowStatus);
+  });
+}
+
+// The replay page: fetch the record's frames; a failure is shown where the time would be.
+function arenaStartReplay(run, record) {
+  arenaWhenReady("arena-canvas", (canvas) => {
+    window.arenaView = new ArenaView(canvas);
+    const label = document.getElementById("arena-time");
+    const url = "/api/runs/" + encodeURIComponent(run) + "/replay?record=" + encodeURIComponent(record);
+    fetch(url)
+      .then((r) => r.ok ? r.json() : r.json().then((d) => { throw new Error(d.detail || r.statusText); },
+                                                        () => { throw new Error(r.statusText); }))
+      .then((d) => {
+        window.arenaReplay = new ArenaReplay(window.arenaView, d,
+          document.getElementById("arena-slider"), label);
+      })
+      .catch((e) => { window.arenaReplayError = String(e.message || e); label.textContent = "error: " + window.arenaReplayError; });
+  });
+}
+
+window.arenaWhenReady = arenaWhenReady;
+window.arenaStartLive = arenaStartLive;
+window.arenaStartReplay = arenaStartReplay;
 window.arenaShowStatus = arenaShowStatus;
 window.ArenaView = ArenaView;
 window.ArenaLive = ArenaLive;
