@@ -4,6 +4,8 @@
 ``GET  /api/health``                   ``{"ok": true, "version": ...}``
 ``GET  /api/runs``                     every run of the store (:class:`~arena.web.store.RunInfo`)
 ``GET  /api/runs/{run}``               one run: its info, results rows and records
+``GET  /api/runs/{run}/summary``       the results page's data (:mod:`arena.web.results`):
+                                       headline table, other metrics, outcomes, radar
 ``GET  /api/runs/{run}/files/{path}``  a file of the run (videos, reports, records)
 ``GET  /api/runs/{run}/replay``        ``?record=PATH``: the episode's scene and every frame,
                                        simulated again from its record
@@ -31,6 +33,7 @@ from arena import __version__
 from arena.core.errors import ArenaError
 from arena.live.frame import LiveFrame, LiveScene, frame_json, scene_json
 from arena.live.server import MAX_LINE, encode
+from arena.web.results import run_view
 from arena.web.store import NotFound, RunStore
 
 #: Longest command a browser may send on the live socket (characters).
@@ -107,6 +110,11 @@ def api_router(store: RunStore) -> APIRouter:
         info = found(store.info, run)
         return {"info": info.as_json(), "results": _clean(found(store.results, run)),
                 "records": found(store.records, run)}
+
+    @router.get("/runs/{run}/summary")
+    def summary(run: str) -> dict[str, Any]:
+        """The results page's data: headline table, other metrics, outcomes, radar."""
+        return found(run_view, store, run)
 
     @router.get("/runs/{run}/files/{path:path}")
     def file(run: str, path: str) -> FileResponse:

@@ -9,13 +9,13 @@ from __future__ import annotations
 
 import html
 import json
-import math
 from datetime import datetime
 from typing import Any
 from urllib.parse import quote
 
 from nicegui import ui
 
+from arena.web.results_page import results_page
 from arena.web.store import NotFound, RunStore
 
 #: The store the pages show (set by :func:`arena.web.server.create_app`).
@@ -23,10 +23,6 @@ STORE: RunStore | None = None
 
 #: Speeds the live view offers (multiples of real time; 0: as fast as it goes).
 SPEEDS = {"¼×": 0.25, "½×": 0.5, "1×": 1.0, "2×": 2.0, "4×": 4.0, "8×": 8.0, "max": 0.0}
-#: Result columns shown first, when a run has them.
-COLUMNS = ("contestant", "stage", "episode", "index", "map", "outcome", "time", "path_length",
-           "collisions", "success", "min_distance_to_person")
-
 SCRIPT = '<script src="/static/arena_view.js"></script>'
 CANVAS = ('<canvas id="arena-canvas" style="width:100%;height:72vh;display:block;'
           'border-radius:6px"></canvas>')
@@ -44,12 +40,6 @@ def _header(title: str) -> None:
         ui.label(title).classes("text-slate-200")
         ui.space()
         ui.link("API", "/docs").classes("text-slate-300")
-
-
-def _cell(value: Any) -> str:
-    if isinstance(value, float):
-        return "–" if not math.isfinite(value) else f"{value:.3g}"
-    return html.escape(str(value))
 
 
 @ui.page("/")
@@ -77,36 +67,17 @@ def index() -> None:
 def _table_style() -> None:
     ui.add_css(".arena-table{border-collapse:collapse;font-size:14px}"
                ".arena-table td,.arena-table th{padding:4px 10px;border-bottom:1px solid #ddd;"
-               "text-align:left}")
+               "text-align:left}.arena-table .iv{color:#666;font-size:0.9em}"
+               ".arena-table tr.o-collision td,.arena-table tr.o-timeout td,"
+               ".arena-table tr.o-error td{background:#fff4f0}")
 
 
 @ui.page("/runs/{run}")
 def results(run: str) -> None:
-    """A run's episodes with their figures and a replay link each."""
+    """A run's results: tables, charts and its episodes with a replay link each."""
     _header(run)
-    try:
-        info = _store().info(run)
-        rows = _store().results(run)
-    except NotFound as e:
-        ui.label(str(e)).classes("text-red-700")
-        return
-    if info.live:
-        ui.link("watch it live", f"/live/{quote(run)}")
-    if not rows:
-        ui.label("No finished episode yet.")
-        return
-    cols = [c for c in COLUMNS if c in rows[0]]
-    head = "".join(f"<th>{c}</th>" for c in cols) + "<th></th>"
-    body = []
-    for row in rows:
-        rec = str(row.get("record") or "")
-        link = (f'<a href="/replay/{quote(run)}?record={quote(rec)}">replay</a>'
-                if rec.endswith(".parquet") else "")
-        body.append("<tr>" + "".join(f"<td>{_cell(row.get(c, ''))}</td>" for c in cols)
-                    + f"<td>{link}</td></tr>")
-    ui.html(f'<table class="arena-table"><tr>{head}</tr>{"".join(body)}</table>',
-            sanitize=False)
     _table_style()
+    results_page(_store(), run)
 
 
 @ui.page("/live/{run}")
