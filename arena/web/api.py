@@ -23,8 +23,9 @@ import asyncio
 import contextlib
 import json
 import math
+from collections.abc import Callable
 from functools import lru_cache
-from typing import Any
+from typing import Any, TypeVar
 
 from fastapi import APIRouter, HTTPException, Query, WebSocket, WebSocketDisconnect
 from fastapi.responses import FileResponse
@@ -35,6 +36,8 @@ from arena.live.frame import LiveFrame, LiveScene, frame_json, scene_json
 from arena.live.server import MAX_LINE, encode
 from arena.web.results import run_view
 from arena.web.store import NotFound, RunStore
+
+T = TypeVar("T")
 
 #: Longest command a browser may send on the live socket (characters).
 MAX_COMMAND = 4096
@@ -89,7 +92,7 @@ def api_router(store: RunStore) -> APIRouter:
     """The API on ``store`` (see the module doc)."""
     router = APIRouter(prefix="/api")
 
-    def found(call: Any, *args: Any) -> Any:
+    def found(call: Callable[..., T], *args: Any) -> T:
         try:
             return call(*args)
         except NotFound as e:

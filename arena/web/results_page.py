@@ -55,7 +55,7 @@ def metric_title(entry: Mapping[str, Any]) -> str:
     """``label [unit] ↑`` (↑: higher is better, ↓: lower is better)."""
     label = entry.get("label") or str(entry["metric"]).replace("_", " ")
     unit = entry.get("unit") or ""
-    arrow = {True: " ↑", False: " ↓"}.get(entry.get("higher"), "")
+    arrow = {True: " ↑", False: " ↓", None: ""}[entry.get("higher")]
     return label + (f" [{unit}]" if unit and unit not in ("1", "-") and "[" not in label else "") \
         + arrow
 
