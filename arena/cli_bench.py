@@ -6,6 +6,8 @@ as one line there.
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
 from enum import StrEnum
 from pathlib import Path
 from typing import Annotated
@@ -85,13 +87,19 @@ def bench(
                      help="wall-clock limit of one episode: past it, its worker is killed and "
                           "the episode ends as error (0: no limit) \\[default: 600]"),
     ] = None,
+    live: Annotated[
+        bool, typer.Option("--live", help="watch the workers' episodes in the browser: the web "
+                           "app on 127.0.0.1 (pip install 'arena\\[web]'); watching only, it "
+                           "changes no result")
+    ] = False,
+    port: Annotated[int, typer.Option(help="--live: the web app's port")] = 8080,
 ) -> None:
     """Benchmark: every contestant on every episode of a suite; resumable, parallel.
 
     Results land in the run folder (``episodes/<contestant>/<stage>/<episode>.parquet|json``,
     ``run.json``); a killed run continues with ``--resume RUN_DIR``. An episode whose worker
     dies (a crashing planner) or that runs past ``--episode-timeout`` ends as ``error``; the
-    run goes on.
+    run goes on. With ``--live`` the web app shows each worker's current episode.
     """
     import math
     import warnings
@@ -147,19 +155,40 @@ def bench(
     if run_dir is None:
         name = Path(contest).stem
         run_dir = Path("runs") / f"bench_{name}_{datetime.now().strftime('%y-%m-%d_%H-%M-%S')}"
-    with warnings.catch_warnings():
+    if live and backend is BenchBackend.ray:
+        raise ArenaError("--live works with the process backend (--backend process)")
+    with warnings.catch_warnings(), _live_web(run_dir, live, port):
         # one line per warning (a stage the scale drops ...), not Python's two with a source line
         warnings.showwarning = lambda message, *args, **kwargs: err_console.print(
             f"[yellow]warning:[/] {message}", highlight=False, soft_wrap=True)
         run = run_benchmark(
             suite, contest, run_dir, base_cfg=base_cfg, workers=workers,
             resume=resume is not None, scale=scale, progress=progress, backend=backend.value,
-            ray_address=ray_address, worlds=worlds, **limit,
+            ray_address=ray_address, worlds=worlds, live=live, **limit,
         )
     _print_bench_tables(load_results(run), f"{suite} · {Path(contest).stem} · seed {seed}")
     console.print(f"run folder: {run}")
     if report:
         _write_report(run, None, videos=1, workers=workers)
+
+
+@contextlib.contextmanager
+def _live_web(run_dir: Path, live: bool, port: int) -> Iterator[None]:
+    """With ``live``: the web app on the run's parent folder while the benchmark runs."""
+    if not live:
+        yield
+        return
+    from arena.web.server import require_web, serve_subprocess
+
+    require_web()
+    run_dir.parent.mkdir(parents=True, exist_ok=True)
+    web = serve_subprocess(run_dir.parent, port=port)
+    try:
+        console.print(f"live view:   {web.url}/live/{run_dir.name}", highlight=False,
+                      soft_wrap=True)
+        yield
+    finally:
+        web.stop()
 
 
 #: Columns of the per-contestant table ``arena bench`` prints: (metric, header, format).

@@ -33,6 +33,7 @@ from typing import Any
 
 from arena.config.schema import ExperimentConfig
 from arena.core.errors import ArenaError, ConfigError
+from arena.eval import live_bench
 from arena.eval.record import EpisodeRecord
 from arena.eval.store import (
     MANIFEST,
@@ -177,7 +178,9 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
         row.update(seed=int(episode.seed), map=episode.map_name,
                    robot=episode.robots[0].model.name)
         backend = BACKENDS.build(cfg.sim.backend, path="sim.backend")
-        res = run_episode(cfg, episode, backend, None, runtime=gen.runtime(episode))
+        watched = live_bench.hooks(f"{job.contestant} · {job.stage} · episode {job.episode}")
+        res = run_episode(cfg, episode, backend, None, runtime=gen.runtime(episode),
+                          hooks=watched)
         row.update(outcome=res.outcome, time=float(res.time), path_length=res.path_length,
                    collisions=int(res.collisions), error=res.error)
         record = res.record
@@ -193,8 +196,14 @@ def run_job(job: Job) -> tuple[dict[str, Any], EpisodeRecord | None]:
     return row, record
 
 
-def _warm_up() -> None:
-    """A fresh worker's imports (registries, simulator, metrics), before its first job."""
+def _warm_up(live_run: str | None = None) -> None:
+    """A fresh worker's imports (registries, simulator, metrics), before its first job.
+
+    With ``live_run`` (a run folder) the worker also serves its episodes live
+    (:mod:`arena.eval.live_bench`).
+    """
+    if live_run is not None:  # first: a viewer may connect while the imports run
+        live_bench.start(live_run)
     import arena.eval.episodes
     import arena.eval.metrics
     import arena.plugins  # noqa: F401
@@ -235,6 +244,7 @@ def run_benchmark(
     ray_address: str | None = None,
     episode_timeout: float | None = DEFAULT_EPISODE_TIMEOUT,
     worlds: str | Path | None = None,
+    live: bool = False,
 ) -> Path:
     """Run (or resume) a benchmark into ``run_dir``; return the run folder.
 
@@ -264,6 +274,9 @@ def run_benchmark(
         worlds: the folder of worlds in Arena's layout that the suite's world names are looked
             up in first (:mod:`arena.tasks.suite`); ``None``: the suite's ``worlds`` key, if
             any. Part of the run's settings (the manifest keeps the folder used).
+        live: every worker serves the episode it runs for watching
+            (:mod:`arena.eval.live_bench`; process backend only). Not part of the run's
+            settings: it changes no result.
 
     Warns:
         UserWarning: once per stage that ``scale`` drops to 0 episodes.
@@ -287,6 +300,9 @@ def run_benchmark(
 
     if backend not in ("process", "ray"):
         raise ArenaError(f"unknown backend {backend!r}; expected 'process' or 'ray'")
+    if live and backend == "ray":
+        raise ArenaError("live viewing works with the process backend; drop --live or use "
+                         "--backend process")
     if backend == "ray":
         try:
             import ray  # noqa: F401
@@ -334,14 +350,14 @@ def run_benchmark(
     todo = [j for j in jobs if j.key not in done]
     total = len(jobs)
     _execute(run, todo, total, total - len(todo), workers, progress, backend, ray_address,
-             episode_timeout)
+             episode_timeout, live)
     return run
 
 
 def _execute(
     run: Path, todo: Sequence[Job], total: int, start: int, workers: int,
     progress: bool | ProgressFn | None, backend: str, ray_address: str | None = None,
-    episode_timeout: float | None = None,
+    episode_timeout: float | None = None, live: bool = False,
 ) -> None:
     bar: Any = None
     task: Any = None
@@ -384,14 +400,19 @@ def _execute(
         if backend == "ray":
             _execute_ray(todo, workers, commit, address=ray_address, timeout=episode_timeout)
         elif workers == 0:
+            if live:
+                live_bench.start(run)
             for job in todo:
                 commit(run_job(job))
         elif todo:
             from arena.eval.workers import run_jobs
 
             run_jobs(todo, run_job, commit, _error_result, workers=workers,
-                     timeout=episode_timeout, initializer=_warm_up)
+                     timeout=episode_timeout, initializer=_warm_up,
+                     initargs=(str(run) if live else None,))
     finally:
+        if workers == 0 and live:
+            live_bench.stop()
         if bar is not None:
             bar.stop()
 

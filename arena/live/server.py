@@ -106,6 +106,8 @@ class LiveServer:
         self._closed = False
         self.frames_sent = 0
         """Frames handed to clients (for benchmarks and tests)."""
+        self.title = ""
+        """What the next scene is (a benchmark's contestant, stage and episode); in its JSON."""
         if control is not None:
             control.listeners.append(self._status)
         threading.Thread(target=self._accept, name="arena-live-accept", daemon=True).start()
@@ -127,11 +129,11 @@ class LiveServer:
         host, port = self.address
         return {"host": host, "port": port, "token": self.token, "pid": os.getpid()}
 
-    def write_info(self, folder: str | Path) -> Path:
-        """Write ``live.json`` into ``folder`` (owner-readable only); its path."""
-        path = Path(folder) / LIVE_FILE
+    def write_info(self, folder: str | Path, name: str = LIVE_FILE) -> Path:
+        """Write :meth:`info` as ``name`` into ``folder`` (owner-readable only); its path."""
+        path = Path(folder) / name
         path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{LIVE_FILE}.{os.getpid()}.tmp")
+        tmp = path.with_name(f".{name}.{os.getpid()}.tmp")
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
         with os.fdopen(fd, "w") as f:
             json.dump(self.info(), f)
@@ -145,7 +147,8 @@ class LiveServer:
 
     def scene(self, scene: LiveScene) -> None:
         """Send a new episode's scene to every viewer (their stale frames dropped)."""
-        line = encode(scene_json(scene))
+        line = encode({**scene_json(scene), "title": self.title} if self.title
+                      else scene_json(scene))
         with self._lock:
             self._scene, self._frame = line, None
             for c in self._clients:
@@ -296,7 +299,12 @@ class LiveClient:
     @classmethod
     def from_run(cls, run_dir: str | Path, *, timeout: float = 10.0) -> LiveClient:
         """Connect to the run in ``run_dir`` (its ``live.json``)."""
-        info = json.loads((Path(run_dir) / LIVE_FILE).read_text())
+        return cls.from_info(Path(run_dir) / LIVE_FILE, timeout=timeout)
+
+    @classmethod
+    def from_info(cls, path: str | Path, *, timeout: float = 10.0) -> LiveClient:
+        """Connect to the channel a ``live.json``-like file at ``path`` announces."""
+        info = json.loads(Path(path).read_text())
         return cls(str(info["host"]), int(info["port"]), str(info["token"]), timeout=timeout)
 
     def send(self, message: dict[str, Any]) -> None:

@@ -3,14 +3,16 @@
 =====================================  =========================================================
 ``GET  /api/health``                   ``{"ok": true, "version": ...}``
 ``GET  /api/runs``                     every run of the store (:class:`~arena.web.store.RunInfo`)
-``GET  /api/runs/{run}``               one run: its info, results rows and records
+``GET  /api/runs/{run}``               one run: its info, results rows, records and live
+                                       channels (``live``; a bench's ``worker_<pid>``)
 ``GET  /api/runs/{run}/summary``       the results page's data (:mod:`arena.web.results`):
                                        headline table, other metrics, outcomes, radar
 ``GET  /api/runs/{run}/files/{path}``  a file of the run (videos, reports, records)
 ``GET  /api/runs/{run}/replay``        ``?record=PATH``: the episode's scene and every frame,
                                        simulated again from its record
-``WS   /api/runs/{run}/live``          the run's live channel (:mod:`arena.live.server`):
-                                       scenes, frames and statuses down, commands up
+``WS   /api/runs/{run}/live``          the run's live channel (:mod:`arena.live.server`;
+                                       ``?channel=``: a bench worker's): scenes, frames and
+                                       statuses down, commands up
 =====================================  =========================================================
 
 Errors are JSON ``{"detail": "one line"}`` with status 404 (no such run or file) or 422 (bad
@@ -112,7 +114,7 @@ def api_router(store: RunStore) -> APIRouter:
     def run(run: str) -> dict[str, Any]:
         info = found(store.info, run)
         return {"info": info.as_json(), "results": _clean(found(store.results, run)),
-                "records": found(store.records, run)}
+                "records": found(store.records, run), "channels": list(store.channels(run))}
 
     @router.get("/runs/{run}/summary")
     def summary(run: str) -> dict[str, Any]:
@@ -132,15 +134,16 @@ def api_router(store: RunStore) -> APIRouter:
         return found(_replay, str(path), path.stat().st_mtime)
 
     @router.websocket("/runs/{run}/live")
-    async def live(ws: WebSocket, run: str) -> None:
+    async def live(ws: WebSocket, run: str, channel: str | None = None) -> None:
         try:
-            info = store.live(run)
+            info = store.live(run, channel)
         except NotFound:
             info = None
         await ws.accept()
         if info is None:
-            await ws.send_text(json.dumps({"type": "closed", "message":
-                                           f"run {run!r} is not running"}))
+            what = f"run {run!r}" + (f" has no live channel {channel!r}" if channel else
+                                     " is not running")
+            await ws.send_text(json.dumps({"type": "closed", "message": what}))
             await ws.close()
             return
         try:

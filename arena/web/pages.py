@@ -39,6 +39,7 @@ def _header(title: str) -> None:
         ui.link("Arena", "/").classes("text-white text-lg font-bold no-underline")
         ui.label(title).classes("text-slate-200")
         ui.space()
+        ui.link("editor", "/editor").classes("text-slate-300")
         ui.link("API", "/docs").classes("text-slate-300")
 
 
@@ -81,16 +82,24 @@ def results(run: str) -> None:
 
 
 @ui.page("/live/{run}")
-def live(run: str) -> None:
-    """The live view: canvas, pause/step/speed, and goal or teleport by clicking."""
+def live(run: str, channel: str = "") -> None:
+    """The live view: canvas, pause/step/speed, and goal or teleport by clicking.
+
+    A benchmark's workers each have a channel (``?channel=worker_<pid>``, links above the
+    canvas); they are for watching only, so the controls answer with an error there.
+    """
     _header(f"{run} · live")
     try:
-        _store().folder(run)
+        bench = _store().info(run).kind == "bench"
     except NotFound as e:
         ui.label(str(e)).classes("text-red-700")
         return
     ui.add_head_html(SCRIPT)
-    with ui.row().classes("items-center gap-2"):
+    ui.html('<div id="arena-channels" style="font-size:14px"></div>', sanitize=False)
+    if bench:
+        ui.label("A benchmark is watched only: its episodes are not paused or steered, so its "
+                 "results do not depend on a viewer.").classes("text-slate-600")
+    with ui.row().classes("items-center gap-2").set_visibility(not bench):
         # the buttons talk to the run's WebSocket from the browser (no round trip here)
         for name, message in (("pause", {"cmd": "pause"}), ("resume", {"cmd": "resume"}),
                               ("step", {"cmd": "step"})):
@@ -103,7 +112,7 @@ def live(run: str) -> None:
                       f"window.arenaView.tool = {json.dumps(e.value or None)}"))
     ui.html('<div id="arena-status" style="font-family:monospace;font-size:13px">connecting'
             "…</div>" + CANVAS, sanitize=False).classes("w-full")
-    ui.add_body_html(f"<script>arenaStartLive({_js(run)});</script>")
+    ui.add_body_html(f"<script>arenaStartLive({_js(run)}, {_js(channel)});</script>")
 
 
 def _js(value: Any) -> str:

@@ -113,6 +113,7 @@ def create_app(root: str | Path, *, token: str | None = None, pages: bool = True
 
     from arena import __version__
     from arena.web.api import api_router
+    from arena.web.api_editor import editor_router
     from arena.web.store import RunStore
 
     store = RunStore(root)
@@ -120,10 +121,12 @@ def create_app(root: str | Path, *, token: str | None = None, pages: bool = True
                   description="Runs, results, replays and live views of Arena simulations.")
     app.state.store = store
     app.include_router(api_router(store))
+    app.include_router(editor_router(store))
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     if pages:
         from nicegui import ui
 
+        from arena.web import editor  # noqa: F401  (registers the /editor page)
         from arena.web import pages as page_module
 
         page_module.STORE = store

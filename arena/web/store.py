@@ -1,7 +1,8 @@
 """The web app's view of a run store: the run folders under one root folder, read safely.
 
-A run is a folder directly under the root: an ``arena bench`` run (``run.json``) or an ``arena
-run`` run (``config.yaml`` and ``episode_*`` folders). Its name is its folder name. Every path a
+A run is a folder directly under the root: an ``arena bench`` run (``run.json``), an ``arena
+run`` run (``config.yaml`` and ``episode_*`` folders), or a job the web app started that has no
+results yet (``job.json``, :mod:`arena.web.jobs`). Its name is its folder name. Every path a
 request names is checked here: run names are one plain folder name, file paths stay inside
 their run (no ``..``, no absolute path, no symlink out), so the app serves nothing but the
 store's files.
@@ -18,6 +19,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
+from arena.eval.live_bench import LIVE_DIR
 from arena.live.server import LIVE_FILE
 
 #: A run name: one folder name of plain characters.
@@ -108,7 +110,8 @@ class RunStore:
         if (path / "config.yaml").is_file() and (
                 any(path.glob("episode_*")) or (path / LIVE_FILE).is_file()):
             return "run"
-        return None
+        kind = _json(path / "job.json").get("kind")  # a job that has written nothing yet
+        return kind if kind in ("bench", "run") else None
 
     # -- reading ----------------------------------------------------------------------------------
     def runs(self) -> list[RunInfo]:
@@ -129,6 +132,8 @@ class RunStore:
         if kind == "bench":
             manifest = _json(folder / "run.json")
             title = " × ".join(Path(str(manifest.get(k, "?"))).stem for k in ("suite", "contest"))
+            if not manifest:  # a job that has not written its manifest yet
+                title = str(_json(folder / "job.json").get("title", title))
             episodes = sum(1 for _ in folder.glob("episodes/*/*/*.json"))
         else:
             title = folder.name
@@ -137,15 +142,32 @@ class RunStore:
         return RunInfo(name=folder.name, kind=kind, episodes=episodes,
                        live=self.live(name) is not None, modified=max(stamps), title=title)
 
-    def live(self, name: str) -> dict[str, Any] | None:
-        """The run's live channel (``live.json``: host, port, token, pid) while its process runs."""
-        path = self.folder(name) / LIVE_FILE
-        if not path.is_file():
-            return None
-        info = _json(path)
-        if not isinstance(info.get("pid"), int) or not pid_alive(info["pid"]):
-            return None
-        return info
+    def channels(self, name: str) -> dict[str, dict[str, Any]]:
+        """The run's open live channels by name, each ``{host, port, token, pid}``.
+
+        An ``arena run`` has one, ``live`` (its ``live.json``); an ``arena bench --live`` one per
+        worker (``live/worker_<pid>.json``, :mod:`arena.eval.live_bench`). A channel whose
+        process is gone is left out.
+        """
+        folder = self.folder(name)
+        files = [(folder / LIVE_FILE, "live"),
+                 *((p, p.stem) for p in sorted((folder / LIVE_DIR).glob("worker_*.json")))]
+        out = {}
+        for path, channel in files:
+            if not path.is_file():
+                continue
+            info = _json(path)
+            if isinstance(info.get("pid"), int) and pid_alive(info["pid"]) and \
+                    isinstance(info.get("port"), int):
+                out[channel] = info
+        return out
+
+    def live(self, name: str, channel: str | None = None) -> dict[str, Any] | None:
+        """One open live channel of run ``name`` (``None``: its first), or ``None``."""
+        channels = self.channels(name)
+        if channel is None:
+            return next(iter(channels.values()), None)
+        return channels.get(channel)
 
     def results(self, name: str) -> list[dict[str, Any]]:
         """One row per finished episode: its figures and metrics.

@@ -307,28 +307,70 @@ function lerpAngle(a, b, t) {
   return a + d * t;
 }
 
-// A view fed by a run's live channel; commands go back on the same socket.
+// A view fed by a run's live channel; commands go back on the same socket. Until the first
+// scene arrives (a run or a benchmark's workers still starting) it tries again every second,
+// for at most `patience` seconds; a channel that has shown an episode is not reopened.
 class ArenaLive {
-  constructor(view, url, status) {
+  constructor(view, url, status, patience = 120) {
     this.view = view;
+    this.url = url;
     this.status = status; // called with each status, error and end message
     this.messages = 0;
-    this.ws = new WebSocket(url);
+    this.scenes = 0;
+    this.deadline = Date.now() + 1000 * patience;
+    view.onPick = (p) => this.send({ cmd: view.tool, x: p.x, y: p.y, theta: p.theta });
+    this.connect();
+  }
+
+  connect() {
+    this.ws = new WebSocket(this.url);
     this.ws.onmessage = (e) => {
       const m = JSON.parse(e.data);
       this.messages += 1;
-      if (m.type === "scene") view.setScene(m);
-      else if (m.type === "frame") view.setFrame(m);
+      if (m.type === "scene") {
+        this.scenes += 1;
+        this.lastFrame = null; // the previous episode's
+        this.view.setScene(m);
+      }
+      else if (m.type === "frame") this.view.setFrame(m);
+      if (m.type === "closed" && this.scenes === 0 && Date.now() < this.deadline) {
+        this.waiting = true;
+        return; // not started yet: onclose tries again
+      }
       if (m.type !== "frame" || m.outcome) this.status(m);
       if (m.type === "frame") this.lastFrame = m;
     };
-    this.ws.onclose = () => this.status({ type: "closed" });
-    view.onPick = (p) => this.send({ cmd: view.tool, x: p.x, y: p.y, theta: p.theta });
+    this.ws.onclose = () => {
+      if (this.scenes === 0 && Date.now() < this.deadline) {
+        setTimeout(() => this.connect(), 1000);
+      } else {
+        this.status({ type: "closed" });
+      }
+    };
   }
 
   send(message) {
     if (this.ws.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(message));
   }
+}
+
+// The links to a benchmark's worker channels (#arena-channels), kept up to date.
+function arenaChannels(run, current) {
+  const el = document.getElementById("arena-channels");
+  if (!el) return;
+  fetch("/api/runs/" + encodeURIComponent(run)).then((r) => r.ok ? r.json() : null).then((d) => {
+    const names = (d && d.channels || []).filter((c) => c !== "live");
+    el.replaceChildren();
+    if (names.length) el.append("workers: ");
+    names.forEach((name, i) => {
+      const a = document.createElement("a");
+      a.href = "/live/" + encodeURIComponent(run) + "?channel=" + encodeURIComponent(name);
+      a.textContent = name.replace("_", " ");
+      a.style.marginRight = "12px";
+      if (name === current || (!current && i === 0)) a.style.fontWeight = "bold";
+      el.append(a);
+    });
+  }).catch(() => {});
 }
 
 // Recorded frames played on a view, positioned by a slider (0 .. frames - 1).
@@ -377,8 +419,10 @@ function arenaShowStatus(m) {
   if (m.type === "status") live.state = m;
   if (m.type === "error") live.error = m.message;
   if (m.type === "closed") live.closed = m.message || "disconnected";
+  if (m.type === "scene") live.title = m.title || "";
   const f = live.lastFrame, s = live.state;
-  let text = f ? `t = ${f.time.toFixed(1)} s   step ${f.step}   people ${f.people.id.length}` : "waiting for the run";
+  let text = f ? `t = ${f.time.toFixed(1)} s   step ${f.step}   people ${f.people.id.length}` : (live.waiting ? "waiting for the run to start (or it has ended)" : "waiting for the run");
+  if (live.title) text = live.title + "   " + text;
   if (s) text += s.paused ? "   paused" : `   pace ${s.speed === 0 ? "max" : s.speed + "×"}`;
   if (f && f.outcome) text += `   episode ended: ${f.outcome}`;
   if (live.closed) text += `   (${live.closed})`;
@@ -396,12 +440,16 @@ function arenaWhenReady(id, fn) {
 }
 
 // The live page: the canvas fed by the run's live WebSocket.
-function arenaStartLive(run) {
+function arenaStartLive(run, channel) {
+  arenaChannels(run, channel);
+  setInterval(() => arenaChannels(run, channel), 3000);
   arenaWhenReady("arena-canvas", (canvas) => {
     window.arenaView = new ArenaView(canvas);
     const scheme = location.protocol === "https:" ? "wss://" : "ws://";
+    const query = channel ? "?channel=" + encodeURIComponent(channel) : "";
     window.arenaLive = new ArenaLive(window.arenaView,
-      scheme + location.host + "/api/runs/" + encodeURIComponent(run) + "/live", arenaShowStatus);
+      scheme + location.host + "/api/runs/" + encodeURIComponent(run) + "/live" + query,
+      arenaShowStatus);
   });
 }
 
@@ -423,6 +471,7 @@ function arenaStartReplay(run, record) {
 }
 
 window.arenaWhenReady = arenaWhenReady;
+window.arenaChannels = arenaChannels;
 window.arenaStartLive = arenaStartLive;
 window.arenaStartReplay = arenaStartReplay;
 window.arenaShowStatus = arenaShowStatus;
