@@ -79,6 +79,16 @@ def run(
                      "(pip install 'arena\\[web]')"),
     ] = False,
     port: Annotated[int, typer.Option(help="--live: the web app's port")] = 8080,
+    web: Annotated[
+        bool, typer.Option("--web/--no-web", help="--live: start the web app, or only serve "
+                           "the live channel (a web app on the run's folder shows it)")
+    ] = True,
+    resume: Annotated[
+        Path | None,
+        typer.Option("--resume", metavar="RUN_DIR",
+                     help="continue the run in this folder with its config.yaml: its finished "
+                          "episodes are kept, the others run"),
+    ] = None,
     plugin: PluginOption = None,
 ) -> None:
     """Run episodes: a robot drives to its goals among people; writes videos and trajectories.
@@ -90,14 +100,32 @@ def run(
     With ``--live`` (or ``--foxglove``) it runs in real time too, shown in the browser (or in
     Foxglove): the live page pauses, steps and changes the pace, and its clicks set goals and
     move the robot.
+
+    ``--resume RUN_DIR`` continues a stopped run: episodes are drawn and seeded by their index,
+    so its summary is the one the run would have written uninterrupted.
     """
     from arena.cli_live import live_session
 
+    if resume is not None:
+        given = [flag for flag, value in (
+            ("CONFIG/overrides", config or overrides), ("--episodes", episodes),
+            ("--robot", robot), ("--map", map_), ("--seed", seed), ("--scenario", scenario),
+            ("--video/--no-video", video)) if value not in (None, [])]
+        if given:
+            raise ArenaError(f"--resume continues the run with its own config.yaml; drop "
+                             f"{', '.join(given)}")
+        if out is not None and out.resolve() != resume.resolve():
+            raise ArenaError("give either --resume RUN_DIR or -o RUN_DIR, not two different "
+                             "folders")
+        if not (resume / "config.yaml").is_file():
+            raise ArenaError(f"{resume}: no config.yaml; not an arena run folder")
+        config, out = str(resume / "config.yaml"), resume
+
     # a browser opens only for someone at a terminal (not in scripts and tests)
-    with live_session(live=live, foxglove=foxglove, web_port=port,
+    with live_session(live=live, foxglove=foxglove, web_port=port, web=web,
                       open_browser=sys.stdout.isatty()) as session:
         _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,
-             plugin, session)
+             plugin, session, resume=resume is not None)
         if session.url and sys.stdin.isatty():  # someone watches: keep the pages up for them
             import threading
 
@@ -109,7 +137,7 @@ def run(
 
 
 def _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,
-         plugin, session) -> None:
+         plugin, session, *, resume: bool = False) -> None:
     """The body of ``arena run`` (its options as arguments, ``session`` its live setup)."""
     from rich.markup import escape
 
@@ -191,7 +219,7 @@ def _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, i
         out_dir, results = run_experiment(
             cfg, out, on_episode=show, modules=extra_modules,
             realtime=interactive and not session.hooks,  # a live view paces the run itself
-            on_step=on_step, hooks=session.hooks, on_start=session.on_start,
+            on_step=on_step, hooks=session.hooks, on_start=session.on_start, resume=resume,
         )
     console.print(table)
     console.print(f"results:     {out_dir}/summary.csv", soft_wrap=True)

@@ -93,6 +93,10 @@ def bench(
                            "changes no result")
     ] = False,
     port: Annotated[int, typer.Option(help="--live: the web app's port")] = 8080,
+    web: Annotated[
+        bool, typer.Option("--web/--no-web", help="--live: start the web app, or only serve "
+                           "the workers' channels (a web app on the run's folder shows them)")
+    ] = True,
 ) -> None:
     """Benchmark: every contestant on every episode of a suite; resumable, parallel.
 
@@ -157,7 +161,7 @@ def bench(
         run_dir = Path("runs") / f"bench_{name}_{datetime.now().strftime('%y-%m-%d_%H-%M-%S')}"
     if live and backend is BenchBackend.ray:
         raise ArenaError("--live works with the process backend (--backend process)")
-    with warnings.catch_warnings(), _live_web(run_dir, live, port):
+    with warnings.catch_warnings(), _live_web(run_dir, live and web, port):
         # one line per warning (a stage the scale drops ...), not Python's two with a source line
         warnings.showwarning = lambda message, *args, **kwargs: err_console.print(
             f"[yellow]warning:[/] {message}", highlight=False, soft_wrap=True)

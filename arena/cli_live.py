@@ -37,9 +37,13 @@ class LiveSession:
 @contextlib.contextmanager
 def live_session(
     *, live: bool, foxglove: bool, web_port: int = WEB_PORT, foxglove_port: int = FOXGLOVE_PORT,
-    open_browser: bool = True,
+    open_browser: bool = True, web: bool = True,
 ) -> Iterator[LiveSession]:
-    """Set up ``--live`` and/or ``--foxglove``; stop everything on exit."""
+    """Set up ``--live`` and/or ``--foxglove``; stop everything on exit.
+
+    ``web=False`` serves the live channel without starting a web app (a web app already shows
+    the run store: the runs it starts use this).
+    """
     session = LiveSession()
     if not (live or foxglove):
         yield session
@@ -70,7 +74,8 @@ def live_session(
         if live:
             from arena.web.server import require_web, serve_subprocess
 
-            require_web()  # before the run starts, not when its folder exists
+            if web:
+                require_web()  # before the run starts, not when its folder exists
 
             channel = LiveServer(control=control)
             stack.callback(channel.close)
@@ -79,9 +84,12 @@ def live_session(
             def started(out: Path) -> None:
                 info = channel.write_info(out)
                 stack.callback(lambda: info.unlink(missing_ok=True))
-                web = serve_subprocess(out.parent, port=web_port)
-                stack.callback(web.stop)
-                session.url = f"{web.url}/live/{out.name}"
+                if not web:
+                    console.print(f"live channel: {info}", highlight=False, soft_wrap=True)
+                    return
+                app = serve_subprocess(out.parent, port=web_port)
+                stack.callback(app.stop)
+                session.url = f"{app.url}/live/{out.name}"
                 console.print(f"live view:   {session.url}", highlight=False, soft_wrap=True)
                 if open_browser:
                     webbrowser.open(session.url)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import csv
 import functools
+import json
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -90,6 +91,7 @@ def run_experiment(
     on_step: Callable[[int, float, float], None] | None = None,
     hooks: Sequence[EpisodeHooks] = (),
     on_start: Callable[[Path], None] | None = None,
+    resume: bool = False,
 ) -> tuple[Path, list[EpisodeResult]]:
     """Run every episode of ``cfg`` and write the outputs under ``out_dir``.
 
@@ -103,6 +105,10 @@ def run_experiment(
         on_step: ``on_step(episode, time, time_limit)`` after each simulated step (s).
         hooks: extra episode hooks of every episode (the live view).
         on_start: called with the output folder once it exists, before the first episode.
+        resume: keep the episodes ``out_dir`` already holds (their ``episode.json`` and
+            record) and run only the others. Every episode is drawn and seeded by its index
+            and the task modules hear every outcome in order, so the summary is the one an
+            uninterrupted run writes (but for wall-clock figures).
 
     ``summary.csv`` has one row per episode: its figures, then every registered metric
     (:func:`episode_metrics`, the values ``arena bench`` stores).
@@ -121,11 +127,12 @@ def run_experiment(
         on_start(out)
     results: list[EpisodeResult] = []
     for i in range(n_episodes):
-        episode = first if i == 0 else generator.episode(i)
+        episode = first if i == 0 else generator.episode(i)  # drawn even when kept: same draws
         video = cfg.output.video and i < cfg.output.video_episodes
         t0 = time.perf_counter()
+        kept = _finished(out / f"episode_{i:03d}") if resume else None
         try:
-            res = run_episode(
+            res = kept or run_episode(
                 cfg,
                 episode,
                 backend,
@@ -150,6 +157,23 @@ def run_experiment(
     if not results:
         _write_summary(out / "summary.csv", results)
     return out, results
+
+
+def _finished(folder: Path) -> EpisodeResult | None:
+    """The result an earlier run left in episode ``folder`` (``None``: run it again).
+
+    ``episode.json`` is written last, so its presence means the episode finished; its record
+    gives the metrics (which the file does not hold). A file that does not read back is run again.
+    """
+    from arena.eval.io import load_record
+
+    try:
+        result = EpisodeResult(**json.loads((folder / "episode.json").read_text()))
+        record = folder / "episode.parquet"
+        result.record = load_record(record) if record.is_file() else None
+    except Exception:  # unreadable JSON or parquet, a field missing: whatever it is, run it again
+        return None
+    return result
 
 
 def _write_summary(path: Path, results: list[EpisodeResult]) -> None:

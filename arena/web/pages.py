@@ -39,6 +39,7 @@ def _header(title: str) -> None:
         ui.link("Arena", "/").classes("text-white text-lg font-bold no-underline")
         ui.label(title).classes("text-slate-200")
         ui.space()
+        ui.link("jobs", "/jobs").classes("text-slate-300")
         ui.link("editor", "/editor").classes("text-slate-300")
         ui.link("API", "/docs").classes("text-slate-300")
 

@@ -114,6 +114,8 @@ def create_app(root: str | Path, *, token: str | None = None, pages: bool = True
     from arena import __version__
     from arena.web.api import api_router
     from arena.web.api_editor import editor_router
+    from arena.web.api_jobs import jobs_router
+    from arena.web.jobs import JobManager
     from arena.web.store import RunStore
 
     store = RunStore(root)
@@ -122,6 +124,9 @@ def create_app(root: str | Path, *, token: str | None = None, pages: bool = True
     app.state.store = store
     app.include_router(api_router(store))
     app.include_router(editor_router(store))
+    manager = JobManager(store.root)
+    app.state.jobs = manager
+    app.include_router(jobs_router(manager))
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     if pages:
         from nicegui import ui
@@ -130,6 +135,9 @@ def create_app(root: str | Path, *, token: str | None = None, pages: bool = True
         from arena.web import pages as page_module
 
         page_module.STORE = store
+        from arena.web import jobs_page  # registers the /jobs page
+
+        jobs_page.MANAGER = manager
         ui.run_with(app, title="Arena", show_welcome_message=False, reconnect_timeout=10.0,
                     storage_secret=token or secrets.token_urlsafe(16))
     if token:

@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import os
 import shutil
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -41,3 +43,39 @@ def browser_page(width: int = 1280, height: int = 900) -> Iterator[Any]:
             yield page
         finally:
             browser.close()
+
+
+def wait_until(predicate: Any, timeout: float = 60.0, what: str = "condition") -> Any:
+    """Poll ``predicate`` every 50 ms until it returns something true; that value.
+
+    Raises:
+        AssertionError: not within ``timeout`` s (a bound, not a speed goal: generous for a
+            loaded two-core machine).
+    """
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+def screenshot(page: Any, name: str, *, full_page: bool = False) -> None:
+    """Save the page as ``$ARENA_SCREENSHOTS/<name>.png`` when that variable names a folder."""
+    folder = os.environ.get("ARENA_SCREENSHOTS")
+    if folder:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(Path(folder) / f"{name}.png"), full_page=full_page)
+
+
+def editor_settled(page: Any) -> bool:
+    """The scenario editor shows the validation of its current state."""
+    return bool(page.evaluate("window.arenaEditor && window.arenaEditor.validated > 0 && "
+                              "!window.arenaEditor.checking"))
+
+
+def editor_click(page: Any, x: float, y: float) -> None:
+    """Click the editor's canvas at the world point ``(x, y)`` (m)."""
+    px, py = page.evaluate(f"window.arenaEditor.pageOf({x}, {y})")
+    page.mouse.click(px, py)

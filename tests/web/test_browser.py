@@ -10,31 +10,11 @@ import signal
 import subprocess
 import sys
 import time
-from pathlib import Path
 
 import pytest
 
 from arena.web.server import free_port, serve_subprocess
-from tests.web.browser_kit import browser_page, chromium_path
-
-SHOTS = Path(os.environ.get("ARENA_SCREENSHOTS", "")) if os.environ.get(
-    "ARENA_SCREENSHOTS") else None
-
-
-def _shot(page, name: str) -> None:
-    if SHOTS is not None:
-        SHOTS.mkdir(parents=True, exist_ok=True)
-        page.screenshot(path=str(SHOTS / f"{name}.png"))
-
-
-def _wait(predicate, timeout: float = 30.0, what: str = "condition"):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out waiting for {what}")
+from tests.web.browser_kit import browser_page, chromium_path, screenshot, wait_until
 
 
 @pytest.fixture
@@ -79,38 +59,38 @@ def test_watch_pause_step_and_set_a_goal(live_run):
     url, _ = live_run
     with browser_page() as page:
         page.goto(url)
-        _wait(lambda: page.evaluate("window.arenaView ? window.arenaView.drawn : 0") > 5,
+        wait_until(lambda: page.evaluate("window.arenaView ? window.arenaView.drawn : 0") > 5,
               what="frames")
         first = _frame(page)
         assert first["people"]["id"] and first["plan"]
         start = first["poses"][0][:2]  # free for the robot's body: it stood there
-        _shot(page, "live")
+        screenshot(page, "live")
         page.click("#arena-pause")
-        _wait(lambda: "paused" in page.inner_text("#arena-status"), what="paused")
+        wait_until(lambda: "paused" in page.inner_text("#arena-status"), what="paused")
         time.sleep(0.3)  # the tick running when the pause came finishes (at most one)
         held = _frame(page)["step"]
         time.sleep(0.6)
         assert _frame(page)["step"] == held
         page.click("#arena-step")
-        _wait(lambda: _frame(page)["step"] == held + 1, what="one step")
+        wait_until(lambda: _frame(page)["step"] == held + 1, what="one step")
         time.sleep(0.4)
         assert _frame(page)["step"] == held + 1
         # set a goal by clicking the canvas where the robot stood earlier (free for its body
         # and a few steps away, so the episode does not end at once)
         x, y = start
         page.get_by_text("set goal").click()
-        _wait(lambda: page.evaluate("window.arenaView.tool") == "goal", what="the goal tool")
+        wait_until(lambda: page.evaluate("window.arenaView.tool") == "goal", what="the goal tool")
         px, py = page.evaluate(
             f"(() => {{ const v = window.arenaView, r = v.canvas.getBoundingClientRect();"
             f" const [sx, sy] = v.toScreen({x}, {y}); const k = r.width / v.canvas.width;"
             f" return [r.left + sx * k, r.top + sy * k]; }})()")
         page.mouse.click(px, py)
         page.click("#arena-resume")
-        goal = _wait(lambda: (g := _frame(page)["goal"]) and math.hypot(g[0] - x, g[1] - y) < 0.1
-                     and g, what="the clicked goal")
+        goal = wait_until(lambda: (g := _frame(page)["goal"])
+                          and math.hypot(g[0] - x, g[1] - y) < 0.1 and g, what="the clicked goal")
         assert math.hypot(goal[0] - x, goal[1] - y) < 0.1
         assert "error" not in page.inner_text("#arena-status")
-        _shot(page, "live_goal")
+        screenshot(page, "live_goal")
 
 
 def test_results_and_replay(live_run):
@@ -118,13 +98,13 @@ def test_results_and_replay(live_run):
     base = url.split("/live/")[0]
     done = root / "watched" / "episode_000" / "episode.json"
     summary = root / "watched" / "summary.csv"  # written after the episode's own files
-    _wait(summary.is_file, timeout=120, what="the first episode")
+    wait_until(summary.is_file, timeout=120, what="the first episode")
     with browser_page() as page:
         page.goto(f"{base}/")
         page.get_by_text("watched").first.click()
         page.get_by_text("replay").first.click()
         try:
-            _wait(lambda: page.evaluate(
+            wait_until(lambda: page.evaluate(
                 "window.arenaReplay ? window.arenaReplay.frames.length : window.arenaReplayError"
                 " ? -1 : 0"), timeout=120, what="the replay")  # simulated again: a loaded machine
         except AssertionError:
@@ -137,7 +117,7 @@ def test_results_and_replay(live_run):
         page.dispatch_event("#arena-slider", "input")
         assert page.evaluate("window.arenaView.frame.step") == steps // 2
         assert f"step {steps // 2}" in page.inner_text("#arena-time")
-        _shot(page, "replay")
+        screenshot(page, "replay")
 
 
 def test_served_pages_refuse_traversal(tmp_path):
