@@ -6,8 +6,10 @@ Without Chromium the browser tests skip on a user's machine and fail in CI
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
+import signal
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -79,3 +81,46 @@ def editor_click(page: Any, x: float, y: float) -> None:
     """Click the editor's canvas at the world point ``(x, y)`` (m)."""
     px, py = page.evaluate(f"window.arenaEditor.pageOf({x}, {y})")
     page.mouse.click(px, py)
+
+
+def kill_jobs(root: Path) -> None:
+    """SIGKILL the process groups of the processes whose command line names ``root``.
+
+    That is every job a test started under ``root`` (wrappers and commands name their folder;
+    a benchmark's workers share its group), orphans of a killed wrapper too; never a pid read
+    from a job file, which the tests also fill with other processes' pids.
+    """
+    own = os.getpgid(0)
+    groups = set()
+    for proc in Path("/proc").glob("[0-9]*"):
+        with contextlib.suppress(OSError):
+            if str(root).encode() in (proc / "cmdline").read_bytes():
+                groups.add(os.getpgid(int(proc.name)))
+    for pgid in groups - {own, 0, 1}:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(pgid, signal.SIGKILL)
+
+
+def draw_scenario(page: Any, url: str, start: tuple[float, float], goal: tuple[float, float],
+                  person: tuple[float, float], waypoints: Any) -> None:
+    """In the editor at ``url``: load small_office, place the robot's start and goal and one
+    person with its waypoints (world points, m) by clicking, and wait for the validation."""
+    page.goto(f"{url}/editor")
+    wait_until(lambda: editor_settled(page), what="the editor's first validation")
+    page.select_option("#editor-world", "small_office")
+    page.select_option("#editor-world-scenario", "")
+    page.click("#editor-load-world")
+    wait_until(lambda: page.inner_text("#editor-map-label") == "world small_office"
+               and editor_settled(page), what="small_office")
+    page.click("#editor-tool-start")
+    editor_click(page, *start)
+    page.click("#editor-tool-goal")
+    editor_click(page, *goal)
+    page.click("#editor-tool-pedestrian")
+    editor_click(page, *person)
+    # placing a person switches to the waypoint tool for it
+    wait_until(lambda: page.evaluate("window.arenaEditor.tool") == "waypoint",
+               what="the waypoint tool")
+    for wp in waypoints:
+        editor_click(page, *wp)
+    wait_until(lambda: editor_settled(page), what="the validation of the drawing")

@@ -6,63 +6,19 @@ screenshot of each step."""
 from __future__ import annotations
 
 import json
-import os
 
-import pytest
-
-from arena.web.server import free_port, serve_subprocess
-from tests.web.browser_kit import (
-    browser_page,
-    chromium_path,
-    editor_click,
-    editor_settled,
-    screenshot,
-    wait_until,
-)
-from tests.web.test_jobs import kill_jobs
+from tests.web.browser_kit import browser_page, draw_scenario, screenshot, wait_until
 
 # small_office: an office around (-10, 3.5) and a free corridor along y = 0 (-12 .. 12 m)
 START, GOAL = (-10.0, 3.5), (8.0, 0.0)  # about 20 m: time to watch it
 PERSON, WAYPOINTS = (-6.0, 0.0), ((0.0, 0.0), (4.0, 0.0))
 
 
-@pytest.fixture
-def server(tmp_path):
-    """``arena web`` on an empty store; stopped, with every job it started, afterwards."""
-    chromium_path()
-    root = tmp_path / "runs"
-    root.mkdir()
-    web = serve_subprocess(root, port=free_port(8400 + os.getpid() % 400),
-                           log=tmp_path / "web.log")
-    try:
-        yield web, root
-    finally:
-        web.stop()
-        kill_jobs(root)
-
-
-def test_create_save_run_watch_results_replay(server):
-    web, root = server
+def test_create_save_run_watch_results_replay(web_app):
+    web, root = web_app
     with browser_page() as page:
         # 1. the editor: a robot start and goal and a person with two waypoints
-        page.goto(f"{web.url}/editor")
-        wait_until(lambda: editor_settled(page), what="the editor")
-        page.select_option("#editor-world", "small_office")
-        page.select_option("#editor-world-scenario", "")
-        page.click("#editor-load-world")
-        wait_until(lambda: page.inner_text("#editor-map-label") == "world small_office"
-                   and editor_settled(page), what="small_office")
-        page.click("#editor-tool-start")
-        editor_click(page, *START)
-        page.click("#editor-tool-goal")
-        editor_click(page, *GOAL)
-        page.click("#editor-tool-pedestrian")
-        editor_click(page, *PERSON)
-        wait_until(lambda: page.evaluate("window.arenaEditor.tool") == "waypoint",
-                   what="the waypoint tool")
-        for wp in WAYPOINTS:
-            editor_click(page, *wp)
-        wait_until(lambda: editor_settled(page), what="the validation")
+        draw_scenario(page, web.url, START, GOAL, PERSON, WAYPOINTS)
         assert page.inner_text("#editor-status").startswith("OK"), page.inner_text(
             "#editor-problems")
         page.fill("#editor-name", "flow")

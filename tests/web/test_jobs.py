@@ -12,7 +12,6 @@ import json
 import os
 import signal
 import time
-from pathlib import Path
 
 import pytest
 from fastapi.testclient import TestClient
@@ -23,27 +22,10 @@ from arena.web.job_requests import BenchRequest, JobError, RunRequest
 from arena.web.jobs import JobConflict, JobManager
 from arena.web.server import create_app
 from arena.web.store import NotFound, RunStore
+from tests.web.browser_kit import kill_jobs
 
 #: Longest wait for a job to reach a state (s).
 WAIT_S = 300.0
-
-
-def kill_jobs(root: Path) -> None:
-    """SIGKILL the process groups of the processes whose command line names ``root``.
-
-    That is every job a test started under ``root`` (wrappers and commands name their folder;
-    a benchmark's workers share its group), orphans of a killed wrapper too; never a pid read
-    from a job file, which the tests also fill with other processes' pids.
-    """
-    own = os.getpgid(0)
-    groups = set()
-    for proc in Path("/proc").glob("[0-9]*"):
-        with contextlib.suppress(OSError):
-            if str(root).encode() in (proc / "cmdline").read_bytes():
-                groups.add(os.getpgid(int(proc.name)))
-    for pgid in groups - {own, 0, 1}:
-        with contextlib.suppress(ProcessLookupError, PermissionError):
-            os.killpg(pgid, signal.SIGKILL)
 
 
 @pytest.fixture

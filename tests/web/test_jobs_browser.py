@@ -3,36 +3,14 @@ done, and links to its results. ``ARENA_SCREENSHOTS=DIR`` keeps screenshots of e
 
 from __future__ import annotations
 
-import os
-
-import pytest
-
-from arena.web.server import free_port, serve_subprocess
-from tests.web.browser_kit import browser_page, chromium_path, screenshot
-from tests.web.test_jobs import kill_jobs
+from tests.web.browser_kit import browser_page, screenshot
 
 #: Longest wait for the run to finish, in ms (a loaded two-core machine).
 DONE_MS = 240_000
 
 
-
-@pytest.fixture
-def server(tmp_path):
-    """``arena web`` on an empty store; stopped, with every job it started, afterwards."""
-    chromium_path()
-    root = tmp_path / "runs"
-    root.mkdir()
-    web = serve_subprocess(root, port=free_port(8600 + os.getpid() % 300),
-                           log=tmp_path / "web.log")
-    try:
-        yield web, root
-    finally:
-        web.stop()
-        kill_jobs(root)
-
-
-def test_start_a_run_watch_it_finish_and_open_its_results(server):
-    web, root = server
+def test_start_a_run_watch_it_finish_and_open_its_results(web_app):
+    web, root = web_app
     with browser_page() as page:
         page.goto(f"{web.url}/jobs")
         page.locator("input#jobs-name").fill("from_the_page")
