@@ -90,17 +90,26 @@ def _replay(path: str, mtime: float) -> dict[str, Any]:
             "outcome": record.meta.outcome}
 
 
+def answered(call: Callable[..., T], *args: Any) -> T:
+    """``call(*args)``, its refusals as one-line HTTP errors (every router of the app).
+
+    :class:`NotFound` is 404; an :class:`ArenaError` is its ``http_status`` (a job's state
+    conflict: 409) or 422; an :class:`OSError` (the store's disk full or gone) is 422.
+    """
+    try:
+        return call(*args)
+    except NotFound as e:
+        raise HTTPException(404, str(e)) from None
+    except ArenaError as e:
+        raise HTTPException(getattr(e, "http_status", 422), str(e)) from None
+    except OSError as e:
+        raise HTTPException(422, f"the run store: {e.strerror or e}") from None
+
+
 def api_router(store: RunStore) -> APIRouter:
     """The API on ``store`` (see the module doc)."""
     router = APIRouter(prefix="/api")
-
-    def found(call: Callable[..., T], *args: Any) -> T:
-        try:
-            return call(*args)
-        except NotFound as e:
-            raise HTTPException(404, str(e)) from None
-        except ArenaError as e:
-            raise HTTPException(422, str(e)) from None
+    found = answered
 
     @router.get("/health")
     def health() -> dict[str, Any]:

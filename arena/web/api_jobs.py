@@ -24,27 +24,16 @@ from typing import Any
 from fastapi import APIRouter, HTTPException, Query, Request
 from fastapi.concurrency import run_in_threadpool
 
-from arena.core.errors import ArenaError
+from arena.web.api import answered
 from arena.web.job_requests import choices, request_schema
-from arena.web.jobs import JobConflict, JobManager
-from arena.web.store import NotFound
+from arena.web.jobs import JobManager
 
 
 def jobs_router(manager: JobManager) -> APIRouter:
     """The jobs API on ``manager`` (see the module doc)."""
     router = APIRouter(prefix="/api")
 
-    def answer(call: Any, *args: Any) -> Any:
-        try:
-            return call(*args)
-        except NotFound as e:
-            raise HTTPException(404, str(e)) from None
-        except JobConflict as e:
-            raise HTTPException(409, str(e)) from None
-        except ArenaError as e:
-            raise HTTPException(422, str(e)) from None
-        except OSError as e:  # the store's disk: full, read-only, removed
-            raise HTTPException(422, f"the run store: {e.strerror or e}") from None
+    answer = answered
 
     @router.get("/jobs")
     def jobs() -> list[dict[str, Any]]:
@@ -62,7 +51,7 @@ def jobs_router(manager: JobManager) -> APIRouter:
                                 ) from None
         # checking the request draws a benchmark's plan (~0.1 s): off the event loop
         status = await run_in_threadpool(answer, manager.start, body)
-        return status.as_json()  # type: ignore[no-any-return]
+        return status.as_json()
 
     @router.get("/jobs/{name}")
     def job(name: str, lines: int = Query(40, ge=0, le=1000)) -> dict[str, Any]:
@@ -71,11 +60,11 @@ def jobs_router(manager: JobManager) -> APIRouter:
 
     @router.post("/jobs/{name}/cancel")
     def cancel(name: str) -> dict[str, Any]:
-        return answer(manager.cancel, name).as_json()  # type: ignore[no-any-return]
+        return answer(manager.cancel, name).as_json()
 
     @router.post("/jobs/{name}/resume")
     def resume(name: str) -> dict[str, Any]:
-        return answer(manager.resume, name).as_json()  # type: ignore[no-any-return]
+        return answer(manager.resume, name).as_json()
 
     for kind in ("suites", "contests", "robots"):  # worlds: the editor's /api/worlds
         router.add_api_route(f"/{kind}", _lister(kind), methods=["GET"],

@@ -60,6 +60,8 @@ STARTING_S = 30.0
 class JobConflict(ArenaError):
     """An action the job's state does not allow (cancel a finished job ...); one line."""
 
+    http_status = 409
+
 
 @dataclass(frozen=True)
 class JobStatus:
