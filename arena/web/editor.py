@@ -12,7 +12,8 @@ from nicegui import ui
 
 from arena.web import pages
 
-SCRIPT = '<script src="/static/editor.js"></script>'
+SCRIPT = "".join(f'<script src="/static/{name}"></script>'
+                 for name in ("editor.js", "editor_panels.js", "editor_draw.js"))
 
 STYLE = """
 .editor{display:grid;grid-template-columns:300px 1fr 340px;gap:12px;width:100%;
@@ -154,4 +155,4 @@ def editor(load: str = "") -> None:
     ui.html(BODY, sanitize=False).classes("w-full")
     # the script waits for the last element of BODY (NiceGUI mounts it after this tag)
     ui.add_body_html("<script>arenaWhenEditorReady(() => arenaStartEditor("
-                     f"{pages._js({'load': load or None})}));</script>")
+                     f"{pages.js_literal({'load': load or None})}));</script>")

@@ -113,10 +113,10 @@ def live(run: str, channel: str = "") -> None:
                       f"window.arenaView.tool = {json.dumps(e.value or None)}"))
     ui.html('<div id="arena-status" style="font-family:monospace;font-size:13px">connecting'
             "…</div>" + CANVAS, sanitize=False).classes("w-full")
-    ui.add_body_html(f"<script>arenaStartLive({_js(run)}, {_js(channel)});</script>")
+    ui.add_body_html(f"<script>arenaStartLive({js_literal(run)}, {js_literal(channel)});</script>")
 
 
-def _js(value: Any) -> str:
+def js_literal(value: Any) -> str:
     """``value`` as a JavaScript literal safe inside a ``<script>`` element."""
     return json.dumps(value).replace("<", "\\u003c").replace(">", "\\u003e")
 
@@ -149,4 +149,4 @@ def replay(run: str, record: str = "") -> None:
             '<input id="arena-slider" type="range" min="0" max="0" value="0" '
             'style="flex:1"><span id="arena-time" style="font-family:monospace">loading…'
             "</span></div>" + CANVAS, sanitize=False).classes("w-full")
-    ui.add_body_html(f"<script>arenaStartReplay({_js(run)}, {_js(record)});</script>")
+    ui.add_body_html(f"<script>arenaStartReplay({js_literal(run)}, {js_literal(record)});</script>")
