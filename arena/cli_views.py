@@ -28,15 +28,27 @@ def print_plugins(
     if name is not None:
         print_plugin(console, describe_plugin(str(kind), name), as_json=as_json)
         return
-    registries = sorted(all_registries().items())
     if kind is not None:
         reg = registry_for(kind)
         registries = [(reg.kind, reg)]
-    rows = [
-        {"kind": kind_key(k), "name": e.name, "tags": list(e.tags), "description": e.summary}
-        for k, reg in registries
-        for e in reg.entries()
-    ]
+    else:
+        known = -1
+        while len(all_registries()) != known:
+            # importing one kind's plugins can create another kind's registry (the learned
+            # local planners bring the reward terms): list those made by the imports too
+            known = len(all_registries())
+            for r in list(all_registries().values()):
+                r.entries()
+        registries = sorted(all_registries().items())
+    rows = []
+    for k, reg in registries:
+        entries = reg.entries()
+        rows += [{"kind": kind_key(k), "name": e.name, "tags": list(e.tags),
+                  "description": e.summary} for e in entries]
+        # another project's name for a plugin: listed under the kind, pointing at the target
+        rows += [{"kind": kind_key(k), "name": alias, "tags": ["alias"],
+                  "description": f"alias of {target}", "alias_of": target}
+                 for alias, target in sorted(reg.aliases().items())]
     if as_json:
         print(json.dumps(rows, indent=2))
         return
@@ -71,6 +83,8 @@ def print_plugin(console: Console, info: dict[str, Any], *, as_json: bool = Fals
         print(json.dumps(info, indent=2))
         return
     head = f"{info['kind']} {info['name']}" + (f" [{info['unit']}]" if "unit" in info else "")
+    if "alias_of" in info:
+        head += f" (alias of {info['alias_of']})"
     if not console.is_terminal:
         print(f"# {head}: {info['summary']}  ({info['source']})")
         if info["parameters"]:

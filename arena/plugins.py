@@ -178,9 +178,10 @@ def registry_for(kind: str) -> Registry[Any]:
 def describe_plugin(kind: str, name: str) -> dict[str, Any]:
     """What ``arena plugins KIND NAME`` shows: kind, name, tags, docstring, parameters.
 
-    ``parameters`` lists each field of the plugin's ``Params`` model as
-    :meth:`~arena.core.params_doc.ParamInfo.as_dict` (name, type, default, unit, description,
-    constraints); a metric also reports its ``unit``.
+    For an alias (``rosnav``) ``name`` is the alias and ``alias_of`` the plugin it stands for,
+    whose docstring and parameters are shown. ``parameters`` lists each field of the plugin's
+    ``Params`` model as :meth:`~arena.core.params_doc.ParamInfo.as_dict` (name, type, default,
+    unit, description, constraints); a metric also reports its ``unit``.
     """
     registry = registry_for(kind)
     entry = registry.entry(name)
@@ -193,6 +194,8 @@ def describe_plugin(kind: str, name: str) -> dict[str, Any]:
                   f"{getattr(code, '__qualname__', type(code).__name__)}",
         "parameters": [p.as_dict() for p in describe_params(entry.params_model)],
     }
+    if entry.name != name:
+        info["name"], info["alias_of"] = name, entry.name
     unit = getattr(entry.obj, "unit", None)
     if isinstance(unit, str):
         info["unit"] = unit

@@ -75,7 +75,11 @@ def test_plugins_piped_is_one_untruncated_line_per_plugin(monkeypatch, capsys):
     assert all(len(r) == 4 for r in rows), lines[:3]
     expected = {(k.replace(" ", "_"), e.name) for k, reg in all_registries().items()
                 for e in reg.entries()}
+    # aliases (Arena's `rosnav`) are listed too, tagged and pointing at their plugin
+    expected |= {(k.replace(" ", "_"), a) for k, reg in all_registries().items()
+                 for a in reg.aliases()}
     assert {(r[0], r[1]) for r in rows} == expected
+    assert ["local_planner", "rosnav", "alias", "alias of rosnav_rl"] in rows
     assert len(rows) == len(expected)
     # long names and descriptions come whole (a rich table at 80 columns cut them)
     zones = next(r for r in rows if r[1] == "modules.clear_forbidden_zones")
@@ -96,7 +100,10 @@ def test_plugins_json_and_one_kind(monkeypatch, capsys):
     for kind in ("local-planners", "local_planner", "local planner"):
         code, out, _ = run_cli(monkeypatch, capsys, "plugins", kind, "--json")
         assert code == 0
-        assert [r["name"] for r in json.loads(out)][:3] == ["cohan", "crowdnav", "dwa"]
+        rows = json.loads(out)
+        plugins = [r["name"] for r in rows if "alias" not in r["tags"]]  # aliases follow targets
+        assert plugins == sorted(plugins) and {"cohan", "crowdnav", "dwa"} <= set(plugins)
+        assert {"rosnav"} <= {r["name"] for r in rows if "alias" in r["tags"]}
         assert {r["kind"] for r in json.loads(out)} == {"local_planner"}
 
 

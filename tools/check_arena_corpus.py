@@ -64,8 +64,8 @@ KINDS = ("map", "scenario", "suite", "contest", "benchmark", "curriculum", "para
          "zones", "robot")
 
 #: Planners of Arena's contests that the project does not have (issue 22).
-ISSUE_22 = ("issue 22: Arena local planners the project lacks (rosnav: Arena's DRL agent; "
-            "dragon, applr, lflh, trail)")
+ISSUE_22 = ("issue 22: Arena local planners the project lacks (lflh, trail; rosnav "
+            "is rosnav_rl's alias, dragon is built)")
 
 #: Expected failures: (glob on the path relative to the corpus, text the detail must contain,
 #: reason). A file matching a pattern whose check fails with that text is XFAIL; one that
@@ -135,12 +135,6 @@ EXPECTED: tuple[tuple[str, str, str], ...] = (
      "not found", "its suite basic.yaml names arena_hospital_small_4.json, which no "
      "arena-simulation-setup world has"),
     ("benchmark/arena-rosnav*/arena_bringup/configs/benchmark/contests/*planners.yaml",
-     "unknown local planner", ISSUE_22),
-    ("benchmark/arena-rosnav/arena_bringup/configs/benchmark/contests/inter.yaml",
-     "unknown local planner", ISSUE_22),
-    ("benchmark/arena-rosnav@humble/arena_bringup/configs/benchmark/contests/inter.yaml",
-     "unknown local planner", ISSUE_22),
-    ("benchmark/arena-rosnav@ros2/arena_bringup/configs/benchmark/contests/inter.yaml",
      "unknown local planner", ISSUE_22),
     ("benchmark/arena-rosnav@humble/arena_bringup/configs/benchmark/contests/basic.yaml",
      "unknown intermediate planner 'navigate_w_replanning_time'",

@@ -14,6 +14,12 @@ is costly to import (numba kernels) may also declare where its ``Params`` live (
 "arena.crowd.models.orca.params:OrcaParams"}``): :meth:`Registry.check` then validates a block
 against them without importing the implementation.
 
+A registry may also declare *aliases* of built-ins (``aliases={"rosnav": "rosnav_rl"}``): another
+project's name for one of ours, so its files load unchanged. An alias resolves to its target's
+:class:`Entry` (same class, same ``Params``, the target's name) in every lookup; it is not a
+second plugin, so :meth:`Registry.names` and :meth:`Registry.entries` list the target once and
+:meth:`Registry.aliases` lists the aliases.
+
 Example::
 
     LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
@@ -76,6 +82,7 @@ class Registry(Generic[T]):
             first lookup of the name (see the module docstring).
         params: built-in name -> ``"module:Class"``, its ``Params`` model in a light module, for
             :meth:`check`; the plugin's ``Params`` must be that class (checked on import).
+        aliases: alias -> built-in name it stands for (see the module docstring).
     """
 
     def __init__(
@@ -85,6 +92,7 @@ class Registry(Generic[T]):
         entry_points: str | None = None,
         builtins: Mapping[str, str] | None = None,
         params: Mapping[str, str] | None = None,
+        aliases: Mapping[str, str] | None = None,
     ) -> None:
         if kind in _ALL:
             raise ValueError(f"a registry for {kind!r} already exists")
@@ -95,6 +103,15 @@ class Registry(Generic[T]):
         self._params: dict[str, str] = dict(params or {})
         if not self._params.keys() <= self._builtins.keys():
             raise ValueError(f"params declared for names that are not built-ins: {self._params}")
+        self._aliases: dict[str, str] = dict(aliases or {})
+        for alias, target in self._aliases.items():
+            # only built-ins: an alias must resolve without loading anything unknown, and may
+            # never shadow (or be shadowed by) a plugin of its own
+            if alias in self._builtins or target not in self._builtins:
+                raise ValueError(
+                    f"alias {alias!r} -> {target!r}: an alias must name a built-in "
+                    f"and not be one"
+                )
         self._entry_points_loaded = entry_points is None
         _ALL[kind] = self
 
@@ -112,6 +129,11 @@ class Registry(Generic[T]):
         """Register ``obj`` under ``name``; a second plugin with the same name is an error."""
         if not name or name != name.strip() or " " in name:
             raise ValueError(f"invalid {self.kind} name {name!r}")
+        if name in self._aliases:
+            raise ValueError(
+                f"duplicate {self.kind} name {name!r}: it is an alias of "
+                f"{self._aliases[name]!r}"
+            )
         declared = self._builtins.get(name)
         module = str(getattr(obj, "__module__", ""))
         if declared is not None and not (module == declared or module.startswith(declared + ".")):
@@ -135,7 +157,7 @@ class Registry(Generic[T]):
             return
         self._entry_points_loaded = True
         for ep in _entry_points(group=self.entry_point_group or ""):
-            if ep.name in self._entries or ep.name in self._builtins:
+            if ep.name in self._entries or ep.name in self._builtins or ep.name in self._aliases:
                 continue  # built-in wins; the duplicate guard is for code registrations
             self.add(ep.name, ep.load(), tags=("third_party",))
 
@@ -143,6 +165,14 @@ class Registry(Generic[T]):
     def builtins(self) -> dict[str, str]:
         """The declared built-ins: name -> the module that registers it."""
         return dict(self._builtins)
+
+    def aliases(self) -> dict[str, str]:
+        """The declared aliases: alias -> the name it stands for."""
+        return dict(self._aliases)
+
+    def resolve(self, name: str) -> str:
+        """``name`` with an alias replaced by its target (other names unchanged)."""
+        return self._aliases.get(name, name)
 
     def _load_builtin(self, name: object) -> None:
         module = self._builtins.get(name) if isinstance(name, str) else None
@@ -162,8 +192,13 @@ class Registry(Generic[T]):
             self._load_builtin(name)
 
     def entry(self, name: str) -> Entry[T]:
-        """The :class:`Entry` for ``name``; unknown names raise with a close match."""
+        """The :class:`Entry` for ``name`` (or for the target of an alias).
+
+        Unknown names raise with a close match.
+        """
         self._load_entry_points()
+        if isinstance(name, str):
+            name = self.resolve(name)
         self._load_builtin(name)
         try:
             return self._entries[name]
@@ -177,7 +212,8 @@ class Registry(Generic[T]):
     def unknown_message(self, name: object) -> str:
         """Message for an unknown name: the close match first, then every known name."""
         known = self.names()
-        close = difflib.get_close_matches(str(name), known, n=1, cutoff=0.5)
+        close = difflib.get_close_matches(str(name), known + sorted(self._aliases), n=1,
+                                          cutoff=0.5)
         hint = f"did you mean {close[0]!r}? " if close else ""
         return f"unknown {self.kind} {name!r}; {hint}known: {', '.join(known) or '(none)'}"
 
@@ -200,7 +236,7 @@ class Registry(Generic[T]):
 
     def __contains__(self, name: object) -> bool:
         self._load_entry_points()
-        return name in self._entries or name in self._builtins
+        return name in self._entries or name in self._builtins or name in self._aliases
 
     def __iter__(self) -> Iterator[str]:
         return iter(self.names())
@@ -237,6 +273,8 @@ class Registry(Generic[T]):
         """
         spec = self._spec(spec, source=source, path=path)
         name = spec["type"]
+        if isinstance(name, str):
+            name = self.resolve(name)
         if isinstance(name, str) and name in self._params and name not in self._entries:
             return self._params_for(name, self._params_of(name), spec, source, path)
         return self.validate(spec, source=source, path=path)[1]

@@ -549,8 +549,9 @@ def contestant_config(
 ) -> ExperimentConfig:
     """``base_cfg`` driven by the contestant's local planner.
 
-    ``inter_planner`` is Arena's intermediate planner; ``bypass`` passes the global path
-    through, which is what our stack does, so it needs no setting here.
+    ``inter_planner`` (Arena's intermediate planner: ``bypass``, ``polite``, ``aggressive`` ...,
+    all registered intermediate planners) is set by :func:`arena.eval.runner.plan_jobs`, not
+    here. A local planner alias (``rosnav``) is kept as written; it builds its target.
     """
     where = f"contestants[{index}].local_planner"
     try:

@@ -39,6 +39,14 @@ def test_every_registry_has_a_conformance_test():
     assert kinds <= set(COVERED), f"registries without conformance test: {kinds - set(COVERED)}"
 
 
+def test_every_alias_is_its_target_plugin():
+    # an alias (Arena's `rosnav`) is looked up, built and documented as its target: no copy
+    for reg in all_registries().values():
+        for alias, target in reg.aliases().items():
+            assert alias not in reg.names(), f"{reg.kind} alias {alias!r} is also a plugin"
+            assert reg.entry(alias) is reg.entry(target)
+
+
 @pytest.mark.parametrize("name", BACKENDS.names())
 def test_backend(name):
     if name == "mujoco":  # the optional extra arena[3d]

@@ -162,3 +162,33 @@ def test_a_builtin_module_that_does_not_register_its_name_fails_loudly(tmp_path,
     with pytest.raises(RuntimeError, match=f"{module} is declared to register test kind lazy c "
                                            "'ghost', did not"):
         reg.get("ghost")
+
+
+def test_an_alias_resolves_to_its_builtin_everywhere(tmp_path, monkeypatch):
+    module = _builtin_module(tmp_path, monkeypatch, "test kind alias a", "ambler", registers=True)
+    reg = Registry("test kind alias a", builtins={"ambler": module}, aliases={"stroll": "ambler"})
+    # an alias is not a second plugin: listed once under its target, shown by aliases()
+    assert reg.names() == ["ambler"] and len(reg) == 1
+    assert reg.aliases() == {"stroll": "ambler"}
+    assert "stroll" in reg and reg.resolve("stroll") == "ambler" and reg.resolve("x") == "x"
+    assert module not in sys.modules  # knowing the alias imports nothing
+    assert reg.get("stroll") is reg.get("ambler")
+    assert reg.entry("stroll").name == "ambler"
+    assert isinstance(reg.build("stroll"), reg.get("ambler"))
+    assert "did you mean 'stroll'" in reg.unknown_message("strol")
+
+
+def test_an_alias_must_name_a_builtin_and_cannot_be_taken(tmp_path, monkeypatch):
+    module = _builtin_module(tmp_path, monkeypatch, "test kind alias b", "ambler", registers=False)
+    with pytest.raises(ValueError, match="alias 'stroll' -> 'runner': an alias must name a"):
+        Registry("test kind alias b", builtins={"ambler": module}, aliases={"stroll": "runner"})
+    with pytest.raises(ValueError, match="alias 'ambler' -> 'ambler'"):
+        Registry("test kind alias c", builtins={"ambler": module}, aliases={"ambler": "ambler"})
+    reg = Registry("test kind alias d", builtins={"ambler": module}, aliases={"stroll": "ambler"})
+
+    class Mine:
+        pass
+
+    with pytest.raises(ValueError, match="duplicate test kind alias d name 'stroll': it is an "
+                                         "alias of 'ambler'"):
+        reg.add("stroll", Mine)

@@ -32,3 +32,31 @@ def test_a_config_imports_only_the_local_planner_it_names() -> None:
     # the orca planner would compile the ORCA crowd kernels; the learned ones load torch weights
     for other in ("orca_planner", "teb", "mpc", "cohan", "crowdnav", "rlca", "learned"):
         assert f"arena.nav.local_planners.{other}" not in loaded
+
+
+def test_rosnav_is_arenas_name_for_rosnav_rl() -> None:
+    # Arena-Rosnav's contest files (planners.yaml, inter.yaml) name the learned planner `rosnav`
+    from arena.learn.planners.learned import LearnedPlanner
+
+    assert LOCAL_PLANNERS.aliases()["rosnav"] == "rosnav_rl"
+    assert LOCAL_PLANNERS.get("rosnav") is LearnedPlanner
+    assert "rosnav" in LOCAL_PLANNERS and "rosnav" not in LOCAL_PLANNERS.names()
+    assert isinstance(LOCAL_PLANNERS.build({"type": "rosnav"}), LearnedPlanner)  # packaged weights
+
+
+def test_an_arena_contest_naming_rosnav_plans_its_jobs() -> None:
+    from arena.config.loader import load_config
+    from arena.eval.runner import plan_jobs
+    from arena.tasks.suite import ContestFile, load_suite
+
+    # Arena's inter.yaml, abridged: rosnav behind Arena's social intermediate planners
+    contest = ContestFile.model_validate({"contestants": [
+        {"name": "rosnav-polite", "local_planner": "rosnav", "inter_planner": "polite"},
+        {"name": "rosnav-aggressive", "local_planner": "rosnav", "inter_planner": "aggressive"},
+    ]})
+    jobs = plan_jobs(load_suite("barn", scale_episodes=0.02), contest, load_config())
+    assert [(j.local_planner, j.inter_planner) for j in jobs] == [
+        ("rosnav", "polite"), ("rosnav", "aggressive")]
+    nav = [j.config["navigation"] for j in jobs]
+    assert [n["local_planner"]["type"] for n in nav] == ["rosnav", "rosnav"]
+    assert [n["intermediate_planner"]["type"] for n in nav] == ["polite", "aggressive"]

@@ -202,7 +202,7 @@ def test_unknown_key_and_malformed_yaml(tmp_path):
     f = _write(tmp_path, "stages:\n  - name: x\n    episodes: [1\n")
     with pytest.raises(ConfigError, match=r"malformed YAML at line \d+"):
         load_suite(f)
-    with pytest.raises(ConfigError, match="packaged: indoor_people, paper, quick"):
+    with pytest.raises(ConfigError, match="packaged: barn, indoor_people, paper, quick"):
         load_suite("papr")
 
 

@@ -173,6 +173,8 @@ _BUILTIN_PLANNERS = {
     "social_force": _NAV + "social_force", "teb": _NAV + "teb",
     "crowdnav": _LEARNED + "crowdnav", "rlca": _LEARNED + "rlca", "rosnav_rl": _LEARNED + "learned",
     "sarl": _LEARNED + "crowdnav",
+    "dragon": _NAV + "dragon",
+    "brne": _NAV + "brne",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
@@ -181,6 +183,8 @@ LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
     # name -> the module registering it, imported when first named: a config does not import
     # every planner (``orca`` compiles the ORCA crowd kernels)
     builtins=_BUILTIN_PLANNERS,
+    # Arena-Rosnav's contest files name its learned planner ``rosnav``
+    aliases={"rosnav": "rosnav_rl"},
 )
 
 
