@@ -1,4 +1,7 @@
-"""The learned local planners: ``rosnav_rl`` (PPO), ``rlca`` (Long et al.), ``crowdnav``/``sarl``.
+"""The learned local planners: ``rosnav_rl``, ``rlca``, ``crowdnav``/``sarl``, ``applr``.
+
+``rosnav_rl`` is a PPO policy, ``rlca`` Long et al.'s, ``crowdnav``/``sarl`` value networks and
+``applr`` DWA whose parameters a TD3 policy sets every second.
 
 They run, with numpy, the policies trained by :mod:`arena.learn` and registered in
 :data:`~arena.nav.local_planners.LOCAL_PLANNERS` under those names (imported when a config

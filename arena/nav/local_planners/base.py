@@ -175,6 +175,7 @@ _BUILTIN_PLANNERS = {
     "sarl": _LEARNED + "crowdnav",
     "dragon": _NAV + "dragon",
     "brne": _NAV + "brne",
+    "applr": _LEARNED + "applr",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
