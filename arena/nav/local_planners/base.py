@@ -176,6 +176,7 @@ _BUILTIN_PLANNERS = {
     "dragon": _NAV + "dragon",
     "brne": _NAV + "brne",
     "applr": _LEARNED + "applr",
+    "lflh": _LEARNED + "lflh",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
