@@ -49,6 +49,7 @@ from arena.core.errors import ConfigError, from_validation_error
 from arena.core.names import RULE, SafeName
 from arena.core.rng import MAX_SEED, Seed, child_seed
 from arena.maps.sources import MAP_SOURCES, check_worlds_folder, resolve_world
+from arena.nav.global_planners.base import GLOBAL_PLANNERS
 from arena.nav.local_planners.base import LOCAL_PLANNERS
 from arena.perception.stage import PERCEPTION
 from arena.tasks.datafiles import find_data_file, read_arena_yaml
@@ -187,6 +188,10 @@ class Contestant(_Arena):
     perception: dict[str, Any] | None = Field(
         None, description="navigation.perception of this contestant (our addition), e.g. "
         "{type: lidar}; default: the run's (the ground truth)",
+    )
+    global_planner: str | dict[str, Any] | None = Field(
+        None, description="navigation.global_planner of this contestant (our addition), a "
+        "name or a block, e.g. artplanner; default: the run's (A*)",
     )
 
 
@@ -335,6 +340,18 @@ class Suite:
             raise ConfigError(e.message, source=self.source, path=where) from None
         return {"type": "world", "name": name}
 
+    def stage_robot(self, i: int) -> str | None:
+        """Stage ``i``'s robot: a preset name or a YAML path; ``None``: the run's.
+
+        A relative YAML path is read relative to the suite file when the file exists there
+        (as world folders are), else as given.
+        """
+        robot = self.stages[i].robot
+        if robot is None or not robot.endswith((".yaml", ".yml")) or Path(robot).is_absolute():
+            return robot
+        near = Path(self.source).parent / robot
+        return str(near.resolve()) if near.is_file() else robot
+
     def _world_folder(self, map_block: dict[str, Any]) -> Path | None:
         if map_block.get("type") != "world":
             return None
@@ -453,7 +470,7 @@ class Suite:
             "name": f"{base_cfg.name}/{st.name}",
             "seed": stage_run_seed(base_cfg.seed, self.seeds[i]),
             "episodes": max(self.episode_counts[i], 1),
-            "robot": st.robot or base["robot"],
+            "robot": self.stage_robot(i) or base["robot"],
             "map": map_block,
             "task": task,
         }
@@ -547,7 +564,7 @@ def load_contest(name_or_path: str | Path) -> tuple[ContestFile, str]:
 def contestant_config(
     base_cfg: ExperimentConfig, contestant: Contestant, *, source: str | None = None, index: int = 0
 ) -> ExperimentConfig:
-    """``base_cfg`` driven by the contestant's local planner.
+    """``base_cfg`` driven by the contestant's local planner (and global planner, if named).
 
     ``inter_planner`` (Arena's intermediate planner: ``bypass``, ``polite``, ``aggressive`` ...,
     all registered intermediate planners) is set by :func:`arena.eval.runner.plan_jobs`, not
@@ -568,6 +585,12 @@ def contestant_config(
         path = f"contestants[{index}].params" + (f".{sub}" if sub else "")
         raise ConfigError(e.message, source=source, path=path) from None
     nav["local_planner"] = block
+    if contestant.global_planner is not None:
+        gp = contestant.global_planner
+        gp_block = {"type": gp} if isinstance(gp, str) else dict(gp)
+        GLOBAL_PLANNERS.validate(gp_block, source=source,
+                                 path=f"contestants[{index}].global_planner")
+        nav["global_planner"] = gp_block
     if contestant.perception is not None:
         PERCEPTION.validate(contestant.perception, source=source,
                             path=f"contestants[{index}].perception")

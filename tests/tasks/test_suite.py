@@ -221,6 +221,25 @@ def test_contestant_planner_params(tmp_path):
     assert e.value.path == "contestants[0].params.max_sped"
 
 
+def test_contestant_global_planner(tmp_path):
+    from arena.tasks.suite import contestant_config
+
+    f = _write(tmp_path, "contestants:\n  - {name: a, local_planner: dwa, global_planner: "
+               "theta_star}\n  - {name: b, local_planner: dwa, global_planner: {type: dijkstra}}"
+               "\n  - {name: c, local_planner: dwa}\n", "contest.yaml")
+    contest, _ = load_contest(f)
+    got = [contestant_config(ExperimentConfig(), c, source=str(f), index=i).navigation
+           for i, c in enumerate(contest.contestants)]
+    assert got[0].global_planner["type"] == "theta_star"
+    assert got[1].global_planner["type"] == "dijkstra"
+    assert got[2].global_planner == ExperimentConfig().navigation.global_planner
+    bad = _write(tmp_path, "contestants:\n  - {name: x, local_planner: dwa, global_planner: "
+                 "astr}\n", "bad.yaml")
+    with pytest.raises(ConfigError, match="did you mean 'astar'") as e:
+        contestant_config(ExperimentConfig(), load_contest(bad)[0].contestants[0], source=str(bad))
+    assert e.value.path == "contestants[0].global_planner.type"
+
+
 @pytest.mark.parametrize(
     "name",
     sorted(p.stem for p in (Path(arena.__file__).parent / "tasks" / "data" / "contests").glob(

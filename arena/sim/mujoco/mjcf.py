@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from arena.core.errors import ConfigError
 from arena.sim.mujoco.gl import choose_gl
 from arena.sim.mujoco.scene import Body, Scene3D
+from arena.sim.mujoco.terrain import HeightField
 
 if TYPE_CHECKING:
     import mujoco
@@ -58,8 +59,16 @@ def to_mjcf(scene: Scene3D) -> str:
     ET.SubElement(visual, "headlight", {"ambient": "0.3 0.3 0.3", "diffuse": "0.4 0.4 0.4"})
     ET.SubElement(visual, "global", {"offwidth": "1280", "offheight": "960"})
     asset = ET.SubElement(root, "asset")
-    used = sorted({g.material for b in scene.bodies for g in b.geoms} | {"floor"})
-    for m in used:
+    terrain = scene.terrain
+    used = {g.material for b in scene.bodies for g in b.geoms} | {"floor"}
+    if isinstance(terrain, HeightField):
+        used.add(terrain.material)
+        ET.SubElement(asset, "hfield", {
+            "name": terrain.name, "nrow": str(terrain.nrow), "ncol": str(terrain.ncol),
+            "size": _num(*terrain.size), "elevation": _num(*terrain.mjcf_elevation())})
+    elif terrain is not None:
+        used |= {g.material for g in terrain.geoms}
+    for m in sorted(used):
         ET.SubElement(asset, "material", {"name": m, "rgba": _num(*p.rgba(m))})
     world = ET.SubElement(root, "worldbody")
     x0, y0, x1, y1 = scene.bounds
@@ -70,9 +79,18 @@ def to_mjcf(scene: Scene3D) -> str:
             "name": f"light/{k}", "directional": "true", "castshadow": "false",
             "pos": _num(cx, cy, 10.0), "dir": _num(*direction), "diffuse": diffuse})
     if p.floor:
+        # Under a height field, whose level parts lie at z = 0, the floor drops 1 mm: the two
+        # coplanar surfaces would flicker (z-fighting) and rays would hit either.
+        floor_z = -1e-3 if isinstance(terrain, HeightField) else 0.0
         ET.SubElement(world, "geom", {"name": "floor", "type": "plane", "material": "floor",
-                                      "pos": _num(cx, cy, 0.0),
+                                      "pos": _num(cx, cy, floor_z),
                                       "size": _num((x1 - x0) / 2, (y1 - y0) / 2, 0.1)})
+    if isinstance(terrain, HeightField):
+        ET.SubElement(world, "geom", {"name": terrain.name, "type": "hfield",
+                                      "hfield": terrain.name, "pos": _num(*terrain.pos),
+                                      "material": terrain.material})
+    elif terrain is not None:
+        _body(world, terrain)
     for body in scene.bodies:
         _body(world, body)
     ET.indent(root)

@@ -9,9 +9,12 @@ writes the same numbers. Sizes follow MuJoCo: box half-extents ``(hx, hy, hz)``,
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
+
+if TYPE_CHECKING:
+    from arena.sim.mujoco.terrain import HeightField
 
 GeomType = Literal["box", "cylinder", "sphere", "capsule", "ellipsoid"]
 
@@ -37,6 +40,7 @@ PALETTE: dict[str, Rgba] = {
     "elder": (0.55, 0.40, 0.60, 1.0),
     "child": (0.90, 0.75, 0.20, 1.0),
     "trousers": (0.18, 0.18, 0.22, 1.0),
+    "terrain": (0.52, 0.48, 0.38, 1.0),
 }
 """Material name -> RGBA (0..1). :class:`WorldParams.colours` overrides any of them."""
 
@@ -53,6 +57,10 @@ class WorldParams(BaseModel):
     )
     max_wall_boxes: int = Field(
         20_000, ge=1, description="most wall boxes after merging (a larger map is refused)"
+    )
+    terrain: Literal["hfield", "boxes"] = Field(
+        "hfield", description="how a height map becomes geometry: a MuJoCo height field, or "
+        "merged boxes (SDF always gets boxes)",
     )
 
     def light_directions(self) -> list[tuple[float, float, float]]:
@@ -124,6 +132,8 @@ class Scene3D:
             ``person/<id>/leg_l``, ``person/<id>/leg_r``.
         actors: people with waypoint routes (what SDF writes as ``<actor>``).
         params: the build parameters (colours, lights).
+        terrain: the ground's height map, if any: a height field, or a static body of boxes
+            (:mod:`arena.sim.mujoco.terrain`); not among :attr:`bodies`.
     """
 
     name: str
@@ -133,6 +143,7 @@ class Scene3D:
     people: tuple[Body, ...] = ()
     actors: tuple[Actor, ...] = ()
     params: WorldParams = field(default_factory=WorldParams)
+    terrain: HeightField | Body | None = None
 
     @property
     def bodies(self) -> tuple[Body, ...]:

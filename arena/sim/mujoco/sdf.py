@@ -10,6 +10,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 from arena.sim.mujoco.scene import Body, Geom, Scene3D
+from arena.sim.mujoco.terrain import HeightField, terrain_boxes
 
 SDF_VERSION = "1.6"
 ACTOR_SKIN = "walk.dae"
@@ -84,7 +85,10 @@ def _actor(world: ET.Element, name: str, route: tuple[tuple[float, float, float,
 
 
 def to_sdf(scene: Scene3D) -> str:
-    """The SDF world of ``scene``: lights, ground plane, walls, obstacles and actors."""
+    """The SDF world of ``scene``: lights, ground plane, walls, obstacles, terrain and actors.
+
+    Terrain is written as merged boxes (:func:`~arena.sim.mujoco.terrain.terrain_boxes`).
+    """
     root = ET.Element("sdf", {"version": SDF_VERSION})
     world = ET.SubElement(root, "world", {"name": sdf_name(scene.name)})
     x0, y0, x1, y1 = scene.bounds
@@ -105,7 +109,10 @@ def to_sdf(scene: Scene3D) -> str:
             plane = ET.SubElement(ET.SubElement(el, "geometry"), "plane")
             _text(plane, "normal", "0 0 1")
             _text(plane, "size", _num(x1 - x0, y1 - y0))
-    for body in scene.static:
+    terrain = scene.terrain
+    if isinstance(terrain, HeightField):  # SDF height maps need an image file: boxes instead
+        terrain = terrain_boxes(terrain.height_map(), max_boxes=scene.params.max_wall_boxes)
+    for body in (*scene.static, *(() if terrain is None else (terrain,))):
         _model(world, body, scene)
     for a in scene.actors:
         _actor(world, a.name, a.route, a.loop)

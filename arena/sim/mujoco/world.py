@@ -27,10 +27,12 @@ from arena.scene.state import Obstacle
 from arena.sim.mujoco.figures import figure_bodies
 from arena.sim.mujoco.scene import Actor, Body, Geom, Scene3D, WorldParams
 from arena.sim.mujoco.shapes import box, cylinder, obstacle_geoms
+from arena.sim.mujoco.terrain import height_field, terrain_boxes
 from arena.sim.mujoco.walls import merge_boxes
 
 if TYPE_CHECKING:
     from arena.maps.grid import OccupancyGrid
+    from arena.maps.terrain import HeightMap
     from arena.robots.model import RobotModel
     from arena.scene.episode import Episode
 
@@ -149,6 +151,7 @@ def build_world(
     params: WorldParams | None = None,
     name: str = "arena",
     source: str = "map",
+    terrain: HeightMap | None = None,
 ) -> Scene3D:
     """The 3-D world of a map with its obstacles, robots and pedestrians.
 
@@ -161,11 +164,19 @@ def build_world(
         params: heights, lights and colours.
         name: the world's name.
         source: what to name in errors (a file, a generator).
+        terrain: the ground's heights (m) on the map's cells, built as ``params.terrain`` says
+            (:mod:`.terrain`); walls, obstacles and robots still stand at z = 0.
 
     Raises:
-        MapError, ConfigError: see :func:`wall_body`, :func:`obstacle_body`, :func:`robot_body`.
+        MapError, ConfigError: see :func:`wall_body`, :func:`obstacle_body`, :func:`robot_body`;
+            a height map that does not cover the map, or needs too many boxes.
     """
     params = params or WorldParams()
+    ground = None
+    if terrain is not None:
+        terrain.check_covers(grid, what=f"height map of {source}")
+        ground = (height_field(terrain) if params.terrain == "hfield"
+                  else terrain_boxes(terrain, max_boxes=params.max_wall_boxes))
     static = (wall_body(grid, params, source=source), *(obstacle_body(o) for o in obstacles))
     robot_bodies = tuple(robot_body(n, m, p) for n, m, p in robots)
     people: list[Body] = []
@@ -183,7 +194,7 @@ def build_world(
     ox, oy = grid.origin
     w, h = grid.size_m
     return Scene3D(name, (ox, oy, ox + w, oy + h), static, robot_bodies, tuple(people),
-                   tuple(actors), params)
+                   tuple(actors), params, ground)
 
 
 def build_episode_world(episode: Episode, params: WorldParams | None = None) -> Scene3D:
