@@ -120,6 +120,65 @@ def gap_expert(
     return _normalised(np.stack([v, om], axis=1), low, high)
 
 
+def people_from_map(
+    semantic: np.ndarray, channels: list[str], roi: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """People of a batched ``semantic`` observation ``(B, C, size, size)``, robot frame.
+
+    Returns ``(B, P, 2)`` cell-centre positions (m), ``(B, P, 2)`` velocities (m/s) and the
+    ``(B, P)`` mask of occupied cells (a cell with ``pedestrian_location`` set, or a non-zero
+    velocity when the map has no location channel).
+    """
+    b, _, size, _ = semantic.shape
+    vx = semantic[:, channels.index("pedestrian_vel_x")]
+    vy = semantic[:, channels.index("pedestrian_vel_y")]
+    occ = (semantic[:, channels.index("pedestrian_location")] > 0
+           if "pedestrian_location" in channels else (vx != 0) | (vy != 0))
+    rows, cols = np.meshgrid(np.arange(size), np.arange(size), indexing="ij")
+    cell = roi / size
+    xy = np.stack([(cols - size // 2 + 0.5) * cell, (rows - size // 2 + 0.5) * cell], axis=-1)
+    pos = np.broadcast_to(xy.reshape(1, -1, 2), (b, size * size, 2))
+    vel = np.stack([vx.reshape(b, -1), vy.reshape(b, -1)], axis=-1)
+    return pos, vel, occ.reshape(b, -1)
+
+
+def vo_scan(
+    scan: np.ndarray, angles: np.ndarray, pos: np.ndarray, vel: np.ndarray, mask: np.ndarray,
+    horizons: tuple[float, ...] = (0.5, 1.0, 1.5), radius: float = 0.5,
+) -> np.ndarray:
+    """``(B, beams)`` scan with each person's predicted positions added as returns.
+
+    Every person is extrapolated at constant velocity to each horizon (s) and drawn as a disc
+    of ``radius`` m: the beams it covers read the disc's near side when that is nearer. The
+    gap follower then steers around where people will be (DRL-VO's velocity-obstacle idea).
+    """
+    out = scan.astype(np.float64).copy()
+    bi, pi = np.nonzero(mask)
+    if bi.size == 0:
+        return out
+    for t in horizons:
+        p = pos[bi, pi] + t * vel[bi, pi]  # (K, 2)
+        d = np.hypot(p[:, 0], p[:, 1])
+        ok = d > radius
+        half = np.arcsin(np.clip(radius / np.maximum(d, 1e-9), 0.0, 1.0))
+        bearing = np.arctan2(p[:, 1], p[:, 0])
+        diff = np.abs((angles[None, :] - bearing[:, None] + np.pi) % (2 * np.pi) - np.pi)
+        hit = (diff <= half[:, None]) & ok[:, None]
+        near = np.where(hit, (d - radius)[:, None], np.inf)
+        np.minimum.at(out, bi, near)
+    return out
+
+
+def vo_expert(
+    obs: dict[str, np.ndarray], low: np.ndarray, high: np.ndarray, angles: np.ndarray,
+    channels: list[str], roi: float, **kw: Any,
+) -> np.ndarray:
+    """:func:`gap_expert` on the newest scan with the people's predicted positions added."""
+    pos, vel, occ = people_from_map(obs["semantic"], channels, roi)
+    scan = vo_scan(_newest_scan(obs["lidar"]), angles, pos, vel, occ)
+    return gap_expert({"goal": obs["goal"], "lidar": scan}, low, high, angles, **kw)
+
+
 def _collect(
     venv: Any, n: int, steps: int, label: Any, drive: Any, noise: float,
     rng: np.random.Generator, gamma: float,
@@ -207,8 +266,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("config")
     ap.add_argument("-o", "--out", type=Path, required=True)
-    ap.add_argument("--expert", choices=["subgoal", "gap"], default="subgoal")
+    ap.add_argument("--expert", choices=["subgoal", "gap", "vo"], default="subgoal")
     ap.add_argument("--samples", type=int, default=200_000, help="steps per collection")
+    ap.add_argument("--extra-config", default=None,
+                    help="a second experiment config (same robot, observation and action) "
+                         "whose world gives as many samples again per round; PPO later "
+                         "trains in CONFIG's world only")
     ap.add_argument("--dagger-rounds", type=int, default=0)
     ap.add_argument("--noise", type=float, default=0.0,
                     help="std of the noise on executed (normalised) actions")
@@ -248,7 +311,12 @@ def main() -> None:
     low, high = dec.range_low[:2], dec.range_high[:2]
     angles = np.asarray(laser_meta(robot.laser)["angles"])
 
+    sem = cfg.learning.env.observation.semantic
+
     def label(raw: dict[str, np.ndarray]) -> np.ndarray:
+        if args.expert == "vo":
+            return vo_expert(raw, low, high, angles, list(sem.channels), sem.roi,
+                             max_speed=args.max_speed or 1.2, slow_distance=args.slow_distance)
         if args.expert == "gap":
             return gap_expert(raw, low, high, angles,
                               max_speed=args.max_speed or 1.2, slow_distance=args.slow_distance)
@@ -263,8 +331,23 @@ def main() -> None:
     pol = model.policy
     rng = np.random.default_rng(1)
     n = tr.n_envs
+    worlds = [venv]
+    if args.extra_config is not None:
+        cfg2, _ = load_training(args.extra_config)
+        if (cfg2.robot != cfg.robot
+                or cfg2.learning.env.observation != cfg.learning.env.observation
+                or cfg2.learning.env.action != cfg.learning.env.action):
+            raise SystemExit(f"{args.extra_config}: robot, learning.env.observation and "
+                             f"learning.env.action must equal those of {args.config}")
+        venv2 = VecNormalize.load(str(ckpt / "vecnormalize.pkl"), make_vec_env(
+            cfg2, tr.n_envs, tr.vec_env, seed=int(run["seed"]) + 2 * 7919,
+            robots_per_world=tr.robots_per_world, respawn=tr.respawn))
+        # normalised with the first world's statistics, which only the first world updates
+        venv2.training = False
+        venv2.obs_rms = venv.obs_rms
+        worlds.append(venv2)
     data: list[tuple[dict[str, np.ndarray], np.ndarray, np.ndarray]] = []
-    for rnd in range(args.dagger_rounds + 1):
+    for rnd, world in ((r, w) for r in range(args.dagger_rounds + 1) for w in worlds):
         t0 = time.perf_counter()
         if rnd == 0:
             def drive(obs: Any, expert_action: np.ndarray) -> np.ndarray:
@@ -276,16 +359,25 @@ def main() -> None:
                 act, _ = model.predict(obs, deterministic=True)
                 return np.asarray(act, np.float32)
         obs_r, act_r, ret_r, (eps, succ, coll) = _collect(
-            venv, n, args.samples // n, label, drive, args.noise, rng, ppo.gamma
+            world, n, args.samples // n, label, drive, args.noise, rng, ppo.gamma
         )
         who = "expert" if rnd == 0 else f"policy (DAgger round {rnd})"
+        who += f" in world {worlds.index(world) + 1}/{len(worlds)}"
         print(f"{who}: {act_r.shape[0]} samples in {time.perf_counter() - t0:.0f} s, "
               f"{eps} episodes: {succ} at the goal, {coll} collisions", flush=True)
         data.append((obs_r, act_r, ret_r))
+        if world is not worlds[-1]:
+            continue  # fit once per round, on the data of every world
         # raw observations normalised with the statistics as they are now (round 0's moved
         # while it collected), so that every sample sees the normalisation the policy will use
-        obs_t = venv.normalize_obs({k: np.concatenate([d[0][k] for d in data]) for k in obs_r})
-        obs_t = {k: np.asarray(v, np.float32) for k, v in obs_t.items()}
+        # only the normalised parts are copied (the scans and maps of a conv policy are large)
+        norm_keys = set(venv.norm_obs_keys) if venv.norm_obs else set()
+        obs_t = {}
+        for k in obs_r:
+            part = np.concatenate([d[0][k] for d in data])
+            if k in norm_keys:
+                part = venv._normalize_obs(part, venv.obs_rms[k])
+            obs_t[k] = np.asarray(part, np.float32)
         act_t = np.concatenate([d[1] for d in data])
         ret_t = np.concatenate([d[2] for d in data])
         t0 = time.perf_counter()

@@ -63,10 +63,6 @@ DEFAULT_CORPUS = REPO.parent / "shared" / "reference" / "arena_files"
 KINDS = ("map", "scenario", "suite", "contest", "benchmark", "curriculum", "parametrized",
          "zones", "robot")
 
-#: Planners of Arena's contests that the project does not have (issue 22).
-ISSUE_22 = ("issue 22: Arena local planners the project lacks (lflh, trail; rosnav "
-            "is rosnav_rl's alias, dragon is built)")
-
 #: Expected failures: (glob on the path relative to the corpus, text the detail must contain,
 #: reason). A file matching a pattern whose check fails with that text is XFAIL; one that
 #: passes is XPASS (the entry is stale). Each reason says why Arena itself cannot use the file
@@ -134,8 +130,6 @@ EXPECTED: tuple[tuple[str, str, str], ...] = (
     ("benchmark/arena-rosnav@unity-simulator/arena_bringup/configs/benchmark/config.yaml",
      "not found", "its suite basic.yaml names arena_hospital_small_4.json, which no "
      "arena-simulation-setup world has"),
-    ("benchmark/arena-rosnav*/arena_bringup/configs/benchmark/contests/*planners.yaml",
-     "unknown local planner", ISSUE_22),
     ("benchmark/arena-rosnav@humble/arena_bringup/configs/benchmark/contests/basic.yaml",
      "unknown intermediate planner 'navigate_w_replanning_time'",
      "inter_planner navigate_w_replanning_time is a ROS 2 nav2 behaviour tree"),

@@ -52,8 +52,9 @@ from gymnasium import spaces
 from numpy.typing import NDArray
 
 from arena.core.errors import ConfigError
-from arena.crowd.semantic import decode_animation, encode_social_state, pedestrian_type_codes
+from arena.crowd.semantic import pedestrian_type_codes
 from arena.learn.config import ObservationConfig
+from arena.learn.ped_maps import MAX_SPEED, semantic_maps, to_robot_frame
 from arena.robots.model import RobotModel
 from arena.sensors.spec3d import RgbdFrame, RgbdSpec
 
@@ -62,8 +63,6 @@ Obs = dict[str, NDArray[Any]]
 
 PED_FEATURES = ("x", "y", "vx", "vy", "type", "social_state")
 """Columns of the ``pedestrians`` observation."""
-MAX_SPEED = 20.0
-"""m/s; velocity features are clipped to ±this (keeps the space bounded)."""
 _N_STATES = 7
 
 
@@ -123,13 +122,6 @@ def _goal_rho_theta(poses: FloatArray, goals: FloatArray) -> tuple[FloatArray, F
     rho = np.hypot(dx, dy)
     theta = (np.arctan2(dy, dx) - poses[:, 2] + np.pi) % (2 * np.pi) - np.pi
     return rho, theta
-
-
-def to_robot_frame(vectors: FloatArray, headings: FloatArray) -> FloatArray:
-    """Rotate ``(N, M, 2)`` world-frame vectors by ``−ψ`` of each world's robot ``(N,)``."""
-    c, s = np.cos(headings)[:, None], np.sin(headings)[:, None]
-    x, y = vectors[..., 0], vectors[..., 1]
-    return np.stack([c * x + s * y, -s * x + c * y], axis=-1)
 
 
 def _as_lists(
@@ -379,29 +371,9 @@ class ObservationBuilder:
         return {"pedestrians": feats, "pedestrians_mask": mask}
 
     def _semantic(self, inp: ObsInput, rel: FloatArray, n: int) -> NDArray[np.float32]:
-        sc = self.config.semantic
-        size = sc.size
-        grid = np.zeros((n, len(sc.channels), size, size), np.float32)
-        if rel.shape[1] == 0:
-            return grid
-        col = np.floor(rel[..., 0] / sc.roi * size).astype(np.int64) + size // 2
-        row = np.floor(rel[..., 1] / sc.roi * size).astype(np.int64) + size // 2
-        inside = inp.ped_mask & (col >= 0) & (col < size) & (row >= 0) & (row < size)
-        w, p = np.nonzero(inside)
-        if w.size == 0:
-            return grid
-        vel = to_robot_frame(inp.ped_vel, inp.poses[:, 2])[w, p]
-        values = {
-            "pedestrian_location": np.ones(w.size),
-            "pedestrian_type": pedestrian_type_codes(inp.ped_kind[w, p]),
-            "pedestrian_vel_x": np.clip(vel[:, 0], -MAX_SPEED, MAX_SPEED),
-            "pedestrian_vel_y": np.clip(vel[:, 1], -MAX_SPEED, MAX_SPEED),
-            "pedestrian_social_state": decode_animation(encode_social_state(inp.ped_state[w, p])),
-        }
-        vals = np.column_stack([values[c] for c in sc.channels]).astype(np.float32)
-        chan = np.arange(len(sc.channels))
-        grid[w[:, None], chan[None, :], row[w, p][:, None], col[w, p][:, None]] = vals
-        return grid
+        vel = to_robot_frame(inp.ped_vel, inp.poses[:, 2])
+        return semantic_maps(self.config.semantic, rel, vel, inp.ped_kind, inp.ped_state,
+                             inp.ped_mask)
 
     def flatten(self, obs: Obs) -> NDArray[np.float32]:
         """``(N, D)`` float32: the parts of a batched observation concatenated in key order."""

@@ -14,9 +14,8 @@
 ``command_table``             ``(k, 3)`` ``[vx, vy, ω]`` of each discrete action (optional)
 ``command_low/high``,         continuous decoding (optional): raw ranges, clip box
 ``range_low/high``
-``fx/conv{i}/w``, ``/b``      format 2 only: Conv1d layers of the ``rlca_conv`` extractor,
-                              ``w`` ``(out, in, kernel)`` (torch's layout), ReLU after each
-``fx/fc/w``, ``fx/fc/b``      format 2 only: its fully connected layer (ReLU)
+``fx/...``                     format 2 only: the conv feature extractor's layers
+                              (:mod:`arena.learn.policy_conv`)
 ``meta``                      JSON: activation, observation keys / shapes / flatten order,
                               normalisation clip and epsilon, action type, command decoding,
                               the ``learning.env.observation`` block, and ``laser``:
@@ -27,11 +26,12 @@
 The flatten order is SB3's: each key's array flattened in C order (``nn.Flatten``), keys in the
 order of the extractor's ``ModuleDict`` (the Dict space's order).
 
-Format 2 (written only for policies with the ``rlca_conv`` extractor,
-:class:`~arena.learn.extractors.RLCAConvExtractor`; MLP policies stay format 1, so readers of
-format 1 keep reading them) adds ``meta["extractor"]`` = ``{"type": "rlca_conv", "scan_key",
-"strides": [...], "other_keys": [...]}``: the features are the scan through the convs and the
-FC layer, then the ``other_keys`` parts flattened, and the MLP above runs on them.
+Format 2 (written only for policies with a conv extractor, ``rlca_conv``
+(:class:`~arena.learn.extractors.RLCAConvExtractor`) or ``drlvo_cnn``
+(:class:`~arena.learn.extractors.DrlvoExtractor`); MLP policies stay format 1, so readers of
+format 1 keep reading them) adds ``meta["extractor"]`` (its ``type`` and layout, see
+:mod:`arena.learn.policy_conv`): the features are the extractor's output, and the MLP above
+runs on them.
 
 :class:`NumpyPolicy` imports no torch: ``act`` reproduces
 ``model.predict(obs, deterministic=True)`` (argmax of the logits, or the Gaussian mean clipped to
@@ -50,6 +50,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from arena.core.errors import ConfigError
+from arena.learn.policy_conv import Features, numpy_extractor, to_numpy
 
 FORMAT = 1
 """Version of the ``.npz`` layout of MLP policies."""
@@ -58,10 +59,6 @@ FORMAT_CONV = 2
 _FORMATS = (FORMAT, FORMAT_CONV)
 _ACTIVATIONS = {"ReLU": "relu", "Tanh": "tanh", "Identity": "identity"}
 _FLAT_KEY = "obs"
-
-
-def _np(t: Any) -> NDArray[np.float32]:
-    return np.asarray(t.detach().cpu().numpy(), dtype=np.float32)
 
 
 def _linear_layers(seq: Any) -> tuple[list[Any], str]:
@@ -129,7 +126,7 @@ def export_policy(
     )
     from stable_baselines3.common.torch_layers import CombinedExtractor, FlattenExtractor
 
-    from arena.learn.extractors import RLCAConvExtractor
+    from arena.learn.policy_conv import export_extractor
 
     policy = model.policy
     if getattr(policy, "squash_output", False):
@@ -138,25 +135,12 @@ def export_policy(
     obs_space = policy.observation_space
     extractor = policy.pi_features_extractor
     fx_meta: dict[str, Any] | None = None
-    if isinstance(extractor, RLCAConvExtractor):
+    if hasattr(extractor, "other_keys"):  # a conv extractor of arena.learn.extractors
         keys = list(obs_space.spaces.keys())
         sub_spaces = {k: obs_space[k] for k in keys}
         obs_type = "dict"
-        import torch.nn as nn
-
-        convs = [m for m in extractor.convs if isinstance(m, nn.Conv1d)]
-        for i, conv in enumerate(convs):
-            arrays[f"fx/conv{i}/w"] = _np(conv.weight)
-            arrays[f"fx/conv{i}/b"] = _np(conv.bias)
-        fc = extractor.fc[1]
-        arrays["fx/fc/w"] = _np(fc.weight)
-        arrays["fx/fc/b"] = _np(fc.bias)
-        fx_meta = {
-            "type": "rlca_conv",
-            "scan_key": extractor.scan_key,
-            "strides": [int(c.stride[0]) for c in convs],
-            "other_keys": list(extractor.other_keys),
-        }
+        fx_arrays, fx_meta = export_extractor(extractor)
+        arrays.update(fx_arrays)
     elif isinstance(extractor, CombinedExtractor):
         import torch.nn as nn
 
@@ -178,8 +162,8 @@ def export_policy(
     layers, act = _linear_layers(policy.mlp_extractor.policy_net)
     layers.append(policy.action_net)
     for i, lin in enumerate(layers):
-        arrays[f"w{i}"] = _np(lin.weight)
-        arrays[f"b{i}"] = _np(lin.bias)
+        arrays[f"w{i}"] = to_numpy(lin.weight)
+        arrays[f"b{i}"] = to_numpy(lin.bias)
     if act == "identity" and len(layers) > 1:
         act = _ACTIVATIONS.get(getattr(policy.activation_fn, "__name__", ""), "identity")
 
@@ -336,26 +320,6 @@ def write_random_policy(
     return _write(path, arrays, pol.meta)
 
 
-def conv1d(
-    x: NDArray[np.float64], w: NDArray[np.float64], b: NDArray[np.float64], stride: int
-) -> NDArray[np.float64]:
-    """Torch's ``Conv1d`` (no padding, no dilation) in numpy.
-
-    Args:
-        x: ``(B, C, L)`` input.
-        w: ``(O, C, K)`` weights.
-        b: ``(O,)`` bias.
-        stride: step between windows.
-
-    Returns:
-        ``(B, O, (L − K) // stride + 1)``.
-    """
-    k = w.shape[2]
-    win = np.lib.stride_tricks.sliding_window_view(x, k, axis=2)[:, :, ::stride, :]
-    out = np.einsum("bclk,ock->bol", win, w, optimize=True) + b[None, :, None]
-    return np.asarray(out, dtype=np.float64)
-
-
 class NumpyPolicy:
     """A policy written by :func:`export_policy`, evaluated with numpy.
 
@@ -392,20 +356,12 @@ class NumpyPolicy:
         self._eps = float(norm.get("epsilon", 0.0))
         self.discrete = self.meta["action"]["type"] == "discrete"
         self.extractor: dict[str, Any] | None = self.meta.get("extractor")
+        self._features: Features | None = None
         if self.extractor is not None:
-            if self.extractor.get("type") != "rlca_conv" or not self.is_dict:
-                raise ConfigError(
-                    f"unknown feature extractor {self.extractor.get('type')!r}", source=source
-                )
-            n_conv = len(self.extractor["strides"])
-            self._conv = [
-                (self.arrays[f"fx/conv{i}/w"].astype(np.float64),
-                 self.arrays[f"fx/conv{i}/b"].astype(np.float64),
-                 int(self.extractor["strides"][i]))
-                for i in range(n_conv)
-            ]
-            self._fc = (self.arrays["fx/fc/w"].astype(np.float64),
-                        self.arrays["fx/fc/b"].astype(np.float64))
+            if not self.is_dict:
+                raise ConfigError("a conv feature extractor needs a Dict observation",
+                                  source=source)
+            self._features = numpy_extractor(self.extractor, self.arrays, source)
 
     def _unstack_single_scan(self) -> None:
         """Read a ``lidar`` of shape ``(1, beams)`` (older files) as ``(beams,)``.
@@ -480,19 +436,12 @@ class NumpyPolicy:
     def features(self, obs: Any) -> NDArray[np.float64]:
         """``(B, D)`` input of the policy MLP: the flattened observation, or the conv features."""
         parts = self.normalised(obs)
-        if self.extractor is None:
+        if self._features is None:
             return np.concatenate(
                 [parts[k].reshape(parts[k].shape[0], -1) for k in self.keys], axis=1
             )
-        x = parts[self.extractor["scan_key"]]  # (B, stack, beams): channels × length
-        if x.ndim == 2:  # one scan (B, beams): one channel
-            x = x[:, None, :]
-        for w, b, stride in self._conv:
-            x = np.maximum(conv1d(x, w, b, stride), 0.0)
-        w_fc, b_fc = self._fc
-        scan = np.maximum(x.reshape(x.shape[0], -1) @ w_fc.T + b_fc, 0.0)
-        rest = [parts[k].reshape(parts[k].shape[0], -1) for k in self.extractor["other_keys"]]
-        return np.concatenate([scan, *rest], axis=1)
+        assert self._features is not None
+        return self._features(parts)
 
     def logits(self, obs: Any) -> NDArray[np.float64]:
         """``(B, A)`` action logits (discrete) or Gaussian means (continuous), unclipped."""

@@ -224,7 +224,7 @@ def train(
         else:
             venv = VecNormalize(
                 venv, norm_obs=nc.norm_obs, norm_reward=nc.norm_reward, clip_obs=nc.clip_obs,
-                clip_reward=nc.clip_reward, gamma=ppo.gamma,
+                clip_reward=nc.clip_reward, gamma=ppo.gamma, norm_obs_keys=nc.keys,
             )
             lr: Any = (
                 LinearSchedule(ppo.lr_schedule.initial, ppo.lr_schedule.final)

@@ -43,6 +43,10 @@ class Evaluator:
         assert self.model is not None
         if self.train_env is not None:
             sync_envs_normalization(self.train_env, self.venv)
+            # the parts normalised (learning.ppo.normalize.keys) follow the training env's
+            keys = getattr(self.train_env, "norm_obs_keys", None)
+            if keys is not None:
+                self.venv.norm_obs_keys = list(keys)
         self.venv.seed(self.seed)
         obs: Any = self.venv.reset()
         done_eps = successes = 0

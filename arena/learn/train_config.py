@@ -96,8 +96,45 @@ class RLCAConvExtractorConfig(_Strict):
         return self
 
 
+class DrlvoExtractorConfig(_Strict):
+    """DRL-VO's encoder as TRAIL uses it (:class:`arena.learn.extractors.DrlvoExtractor`).
+
+    Two branches: the stacked scans ``scan_key`` ``(stack, beams)``, clipped to ``scan_clip``
+    and scaled to ``[0, 1]``, min- and average-pooled per scan into ``scan_bins`` bins and read
+    as ``2 · stack`` channels of a 1-D signal through ``Conv1d`` layers (``scan_filters``,
+    ``scan_kernels``, ``scan_strides``); the pedestrian kinematic map ``map_key``
+    ``(channels, size, size)`` through ``Conv2d`` layers (``map_filters`` ...). Both flattened,
+    one fully connected layer (ReLU) of width ``fc``, then the other parts appended.
+    """
+
+    type: Literal["drlvo_cnn"] = "drlvo_cnn"
+    scan_key: str = Field("lidar", description="the (stack, beams) observation part")
+    map_key: str = Field("semantic", description="the (channels, size, size) pedestrian map")
+    scan_clip: float = Field(10.0, gt=0, description="m; ranges beyond read as this")
+    scan_bins: int = Field(80, ge=1, description="pooled bins per scan (beams % bins == 0)")
+    scan_filters: list[int] = Field([32, 32], min_length=1)
+    scan_kernels: list[int] = Field([5, 3], min_length=1)
+    scan_strides: list[int] = Field([2, 2], min_length=1)
+    map_filters: list[int] = Field([16, 16], min_length=1)
+    map_kernels: list[int] = Field([5, 3], min_length=1)
+    map_strides: list[int] = Field([2, 2], min_length=1)
+    fc: int = Field(256, ge=1, description="width of the fully connected layer")
+
+    @model_validator(mode="after")
+    def _layers(self) -> DrlvoExtractorConfig:
+        for name in ("scan", "map"):
+            f, k, s = (getattr(self, f"{name}_{x}") for x in ("filters", "kernels", "strides"))
+            if not len(f) == len(k) == len(s):
+                raise ValueError(f"{name}_filters, {name}_kernels and {name}_strides must have "
+                                 "one entry per conv layer")
+            if any(v < 1 for v in (*f, *k, *s)):
+                raise ValueError(f"{name} filters, kernels and strides must be >= 1")
+        return self
+
+
 ExtractorConfig = Annotated[
-    FlattenExtractorConfig | RLCAConvExtractorConfig, Field(discriminator="type")
+    FlattenExtractorConfig | RLCAConvExtractorConfig | DrlvoExtractorConfig,
+    Field(discriminator="type"),
 ]
 """The policy's feature extractor, picked by ``type``."""
 
@@ -109,6 +146,9 @@ class NormalizeConfig(_Strict):
     norm_reward: bool = Field(False, description="normalise rewards by the return's std")
     clip_obs: float = Field(30.0, gt=0, description="clip normalised observations to ±this")
     clip_reward: float = Field(20.0, gt=0, description="clip normalised rewards to ±this")
+    keys: list[str] | None = Field(
+        None, description="Dict observations: the parts to normalise (None: all)"
+    )
 
 
 class PPOConfig(_Strict):
@@ -142,7 +182,7 @@ class PPOConfig(_Strict):
     activation: Literal["relu", "tanh"] = Field("relu", description="hidden-layer activation")
     extractor: ExtractorConfig = Field(
         default_factory=FlattenExtractorConfig,
-        description="feature extractor before the MLPs: flatten (default) or rlca_conv",
+        description="feature extractor before the MLPs: flatten (default), rlca_conv, drlvo_cnn",
     )
     share_features_extractor: bool = Field(
         True, description="actor and critic share the extractor (false: one each, Long et al.)"

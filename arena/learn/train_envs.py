@@ -93,6 +93,8 @@ def make_vec_env(
 ) -> Any:
     """``n_envs`` environments in SB3's ``DummyVecEnv`` or ``SubprocVecEnv``.
 
+    Env ``k`` restarts at episode 0 of ``seed + k`` at its next reset when ``seed`` is given.
+
     ``kind="batched"``: one :class:`~arena.learn.sb3_vec.SB3VecEnv` over a
     :class:`~arena.learn.batched.BatchedSocialNavEnv` of ``n_envs`` worlds (seeded with
     ``seed`` at its next reset when given; ``prefetch`` episodes per world drawn ahead in a
@@ -123,6 +125,9 @@ def make_vec_env(
         return venv
 
     fns = [make_env_fn(cfg, robot) for _ in range(n_envs)]
-    if kind == "subproc" and n_envs > 1:
-        return SubprocVecEnv(fns)
-    return DummyVecEnv(fns)
+    vec = SubprocVecEnv(fns) if kind == "subproc" and n_envs > 1 else DummyVecEnv(fns)
+    if seed is not None:
+        # env k restarts at episode 0 of seed + k at its next reset (without this every env
+        # would play the config seed's episodes: n copies of the same world)
+        vec.seed(int(seed))
+    return vec

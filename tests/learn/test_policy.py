@@ -163,37 +163,60 @@ CONV_OBS = spaces.Dict(
 )
 
 
+DRLVO_OBS = spaces.Dict(
+    {
+        "lidar": spaces.Box(0.0, 12.0, (3, 24), np.float32),
+        "semantic": spaces.Box(-2.0, 2.0, (2, 11, 11), np.float32),
+        "goal": spaces.Box(
+            np.array([0.0, -np.pi], np.float32), np.array([30.0, np.pi], np.float32)
+        ),
+    }
+)
+_FX = {
+    "rlca_conv": (CONV_OBS, {"filters": (4, 5), "kernels": (5, 3), "strides": (2, 2), "fc": 12},
+                  None),
+    "drlvo_cnn": (DRLVO_OBS, {"config": {
+        "scan_clip": 8.0, "scan_bins": 8, "scan_filters": [4, 5], "scan_kernels": [3, 2],
+        "scan_strides": [2, 1], "map_filters": [3, 4], "map_kernels": [3, 2],
+        "map_strides": [2, 1], "fc": 12}}, ["goal"]),
+}
+
+
+@pytest.mark.parametrize("extractor", sorted(_FX))
 @pytest.mark.parametrize("shared", [True, False])
 @pytest.mark.parametrize("act_kind", ["discrete", "box"])
-def test_conv_policy_matches_sb3(tmp_path, shared, act_kind):
-    """The rlca_conv extractor exports (format 2) and numpy equals predict(deterministic)."""
-    from arena.learn.extractors import RLCAConvExtractor
+def test_conv_policy_matches_sb3(tmp_path, extractor, shared, act_kind):
+    """The conv extractors export (format 2) and numpy equals predict(deterministic)."""
+    from arena.learn.extractors import DrlvoExtractor, RLCAConvExtractor
 
+    space, kwargs, norm_keys = _FX[extractor]
     act_space = DISCRETE if act_kind == "discrete" else BOX
     venv = VecNormalize(
-        DummyVecEnv([lambda: _SpaceEnv(CONV_OBS, act_space)]), norm_reward=False, clip_obs=3.0
+        DummyVecEnv([lambda: _SpaceEnv(space, act_space)]), norm_reward=False, clip_obs=3.0,
+        norm_obs_keys=norm_keys,
     )
+    cls = RLCAConvExtractor if extractor == "rlca_conv" else DrlvoExtractor
     model = PPO("MultiInputPolicy", venv, n_steps=8, batch_size=8, seed=3, device="cpu",
                 policy_kwargs={
                     "net_arch": {"pi": [16], "vf": [8]},
                     "share_features_extractor": shared,
-                    "features_extractor_class": RLCAConvExtractor,
-                    "features_extractor_kwargs": {"filters": (4, 5), "kernels": (5, 3),
-                                                  "strides": (2, 2), "fc": 12},
+                    "features_extractor_class": cls,
+                    "features_extractor_kwargs": kwargs,
                 })
     rng = np.random.default_rng(0)
-    CONV_OBS.seed(2)
-    batch = [CONV_OBS.sample() for _ in range(50)]
-    for k in CONV_OBS.spaces:
+    space.seed(2)
+    batch = [space.sample() for _ in range(50)]
+    for k in venv.norm_obs_keys:
         venv.obs_rms[k].update(np.stack([b[k] for b in batch]) * rng.uniform(0.5, 2.0))
     with __import__("torch").no_grad():
         model.policy.action_net.weight.mul_(20.0)
     pol = NumpyPolicy.load(export_policy(model, venv, tmp_path / "c.npz"))
-    assert pol.meta["format"] == 2 and pol.meta["extractor"]["type"] == "rlca_conv"
+    assert pol.meta["format"] == 2 and pol.meta["extractor"]["type"] == extractor
+    assert sorted(pol.meta["normalize"]["keys"]) == sorted(norm_keys or space.spaces)
     venv.training = False
-    CONV_OBS.seed(5)
-    obs = [CONV_OBS.sample() for _ in range(64)]
-    stacked = {k: np.stack([o[k] for o in obs]) for k in CONV_OBS.spaces}
+    space.seed(5)
+    obs = [space.sample() for _ in range(64)]
+    stacked = {k: np.stack([o[k] for o in obs]) for k in space.spaces}
     expect, _ = model.predict(venv.normalize_obs(stacked), deterministic=True)
     got = pol.act(stacked)
     if act_kind == "discrete":
@@ -202,20 +225,6 @@ def test_conv_policy_matches_sb3(tmp_path, shared, act_kind):
         np.testing.assert_allclose(got, expect, rtol=1e-5, atol=1e-5)
     single = pol.act(obs[0])
     np.testing.assert_allclose(np.asarray(single), np.asarray(expect[0]), atol=1e-5)
-
-
-def test_conv1d_matches_torch():
-    import torch
-
-    from arena.learn.policy import conv1d
-
-    rng = np.random.default_rng(1)
-    x = rng.normal(size=(2, 3, 17))
-    w = rng.normal(size=(4, 3, 5))
-    b = rng.normal(size=4)
-    ref = torch.nn.functional.conv1d(torch.as_tensor(x), torch.as_tensor(w), torch.as_tensor(b),
-                                     stride=2).numpy()
-    np.testing.assert_allclose(conv1d(x, w, b, 2), ref, atol=1e-12)
 
 
 def test_format_1_files_still_load(tmp_path):

@@ -168,6 +168,23 @@ def test_batched_vec_env_run_with_real_evaluator(tmp_path):
     assert len(pol.meta["laser"]["angles"]) == 8
 
 
+@pytest.mark.parametrize("kind", ["dummy", "subproc"])
+def test_seeded_vec_envs_play_different_episodes(kind):
+    """Env k of a seeded DummyVecEnv / SubprocVecEnv starts at episode 0 of seed + k."""
+    from arena.learn.env import SocialNavEnv
+    from arena.learn.train import make_vec_env
+
+    cfg = small_cfg()
+    venv = make_vec_env(cfg, 3, kind, small_robot(8), seed=21)
+    first = venv.reset()
+    venv.close()
+    goals = first["goal"]
+    assert len({tuple(np.round(g, 5)) for g in goals}) == 3  # not three copies of one world
+    for k in range(3):
+        own, _ = SocialNavEnv(cfg, robot=small_robot(8)).reset(seed=21 + k)
+        np.testing.assert_array_equal(own["goal"], goals[k])
+
+
 def _state(ckpt):
     from stable_baselines3 import PPO
 

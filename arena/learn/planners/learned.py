@@ -14,8 +14,10 @@ Description:
     (:func:`resample_scan`, the layout recorded in the policy file's ``laser`` meta; files
     without it are taken to have evenly spread full-circle beams).
 
-    Policies whose observation has ``pedestrians`` or ``semantic`` parts are not supported
-    yet (the local observation carries no pedestrian types or social states).
+    ``rosnav_rl`` does not take policies whose observation has ``pedestrians`` or ``semantic``
+    parts; ``trail`` rebuilds ``semantic`` from the observation's known people
+    (:meth:`PolicyPlanner.semantic`; the local observation carries no pedestrian types or
+    social states, so those channels read an adult with no state).
 
     The machinery (observation rebuilding, numpy inference, command limiting) lives in
     :class:`PolicyPlanner`, which other learned planners (``rlca``) subclass with their own
@@ -35,7 +37,9 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
 from arena.core.errors import ConfigError
+from arena.learn.config import SemanticObsConfig
 from arena.learn.paths import subgoal_on_path
+from arena.learn.ped_maps import semantic_maps, to_robot_frame
 from arena.learn.policy import NumpyPolicy
 from arena.nav.local_planners.base import LOCAL_PLANNERS, LocalObservation
 from arena.nav.local_planners.path_tracking import finish_command
@@ -97,6 +101,10 @@ def resample_scan(
     if sa.size == 0 or tgt.size == 0:
         return out
     sr = np.clip(np.where(np.isfinite(sr), sr, range_max), 0.0, range_max)
+    if sa.shape == tgt.shape and np.array_equal(sa, tgt):
+        # the policy's own laser: each bin holds exactly its beam (and the (P, S) comparison
+        # below, 720 × 720 for a jackal, would be most of a control cycle)
+        return sr
     below, above = beam_bins(tgt)
     d = _wrap(sa[None, :] - tgt[:, None])  # (P, S)
     inside = (d >= -below[:, None]) & (d < above[:, None])
@@ -228,12 +236,35 @@ class PolicyPlanner:
             out["last_action"] = np.clip(
                 self._last, pol.arrays["low/last_action"], pol.arrays["high/last_action"]
             ).astype(np.float32)
+        if "semantic" in pol.keys:
+            out["semantic"] = self.semantic(obs)
         if "velocity" in pol.keys:
             twist = np.asarray(obs.twist, dtype=np.float64).reshape(3)
             out["velocity"] = np.clip(
                 twist, pol.arrays["low/velocity"], pol.arrays["high/velocity"]
             ).astype(np.float32)
         return out
+
+    def semantic(self, obs: LocalObservation) -> NDArray[np.float32]:
+        """The ``semantic`` part ``(channels, size, size)`` from ``obs.pedestrians``.
+
+        The maps the policy was trained with (its recorded ``observation.semantic``), drawn
+        by the environments' own :func:`~arena.learn.ped_maps.semantic_maps`.
+        """
+        sem = (self.policy.meta.get("observation") or {}).get("semantic")
+        if sem is None:
+            raise ConfigError(f"{self.policy.source}: the policy records no observation.semantic",
+                              path="navigation.local_planner.weights")
+        sc = SemanticObsConfig(**sem)
+        pose = np.asarray(obs.pose, dtype=np.float64).reshape(3)
+        peds = np.asarray(obs.pedestrians, dtype=np.float64).reshape(-1, 4)
+        heading = pose[2:3]
+        rel = to_robot_frame((peds[:, :2] - pose[:2])[None], heading)
+        vel = to_robot_frame(peds[None, :, 2:4], heading)
+        m = peds.shape[0]
+        grid = semantic_maps(sc, rel, vel, np.zeros((1, m), np.int64),
+                             np.zeros((1, m), np.int64), np.ones((1, m), bool))
+        return grid[0]
 
     def compute(self, obs: LocalObservation) -> NDArray[np.float64]:
         """The policy's command, limited by :func:`finish_command`."""

@@ -177,6 +177,7 @@ _BUILTIN_PLANNERS = {
     "brne": _NAV + "brne",
     "applr": _LEARNED + "applr",
     "lflh": _LEARNED + "lflh",
+    "trail": _LEARNED + "trail",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
