@@ -116,6 +116,9 @@ RANDOM_POLICY = "<random_policy>"
 PLANNER_PARAMS: dict[str, dict[str, Any]] = {
     # no packaged weights needed: an untrained policy in the export layout (made without torch)
     "rosnav_rl": {"weights": RANDOM_POLICY},
+    # the checker's observations carry no camera: iplanner plans on an empty floor's depth image
+    # (its network, spline and pure-pursuit tracking all run; rendered frames: tests/learn)
+    "iplanner": {"missing_frame": "floor"},
 }
 """Parameters (besides ``type``) each local planner is built with."""
 

@@ -202,7 +202,7 @@ def test_unknown_key_and_malformed_yaml(tmp_path):
     f = _write(tmp_path, "stages:\n  - name: x\n    episodes: [1\n")
     with pytest.raises(ConfigError, match=r"malformed YAML at line \d+"):
         load_suite(f)
-    with pytest.raises(ConfigError, match="packaged: barn, indoor_people, paper, quick"):
+    with pytest.raises(ConfigError, match="packaged: barn, barn_rgbd, indoor_people, indoor_people_rgbd, paper, quick"):
         load_suite("papr")
 
 
@@ -258,3 +258,20 @@ def test_every_packaged_contest_builds_its_planners(name):
     if name == "learned":
         assert {c.local_planner for c in contest.contestants} >= {
             "dwa", "rosnav_rl", "rlca", "crowdnav", "sarl"}
+
+
+def test_a_stage_robot_yaml_is_read_relative_to_the_suite_file(tmp_path):
+    (tmp_path / "robots").mkdir()
+    robot = (Path(arena.__file__).parent / "tasks/data/robots/jackal_rgbd.yaml").read_text()
+    (tmp_path / "robots" / "cam.yaml").write_text(robot)
+    f = _write(tmp_path, "stages:\n  - name: a\n    episodes: 1\n    robot: robots/cam.yaml\n"
+               "  - name: b\n    episodes: 1\n    robot: jackal\n")
+    suite = load_suite(f)
+    assert suite.stage_robot(0) == str((tmp_path / "robots" / "cam.yaml").resolve())
+    assert suite.stage_robot(1) == "jackal"
+    cfg = suite.stage_experiment(0, ExperimentConfig())
+    assert "camera" in load_robot(cfg.robot).sensors
+    # the packaged barn_rgbd suite: the barn suite's stage with the camera jackal
+    rgbd, barn = load_suite("barn_rgbd"), load_suite("barn")
+    assert rgbd.seeds == barn.seeds
+    assert load_robot(rgbd.stage_experiment(0, ExperimentConfig()).robot).name == "jackal_rgbd"

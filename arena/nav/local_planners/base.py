@@ -178,6 +178,7 @@ _BUILTIN_PLANNERS = {
     "applr": _LEARNED + "applr",
     "lflh": _LEARNED + "lflh",
     "trail": _LEARNED + "trail",
+    "iplanner": _LEARNED + "iplanner",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
