@@ -64,21 +64,15 @@ class RLCAConvExtractor(BaseFeaturesExtractor):
                 path="learning.ppo.extractor",
             )
         stack, beams = scan_shape if len(scan_shape) == 2 else (1, scan_shape[0])
-        layers: list[nn.Module] = []
-        channels, length = stack, beams
-        for f, k, s in zip(filters, kernels, strides, strict=True):
-            if length < k:
-                raise ConfigError(
-                    f"{beams} beams are too few for the conv layers (kernel {k} on {length})",
-                    path="learning.ppo.extractor",
-                )
-            layers += [nn.Conv1d(channels, int(f), int(k), stride=int(s)), nn.ReLU()]
-            channels, length = int(f), (length - int(k)) // int(s) + 1
+        convs, channels, length = _conv_stack(
+            nn.Conv1d, stack, beams, list(filters), list(kernels), list(strides),
+            f"scan of {beams} beams",
+        )
         self.other_keys = [k for k in observation_space.spaces if k != scan_key]
         other = sum(math.prod(observation_space[k].shape or ()) for k in self.other_keys)
         super().__init__(observation_space, features_dim=int(fc) + other)
         self.scan_key = scan_key
-        self.convs = nn.Sequential(*layers)
+        self.convs = convs
         self.fc = nn.Sequential(nn.Flatten(), nn.Linear(channels * length, int(fc)), nn.ReLU())
 
     def forward(self, observations: dict[str, torch.Tensor]) -> torch.Tensor:
