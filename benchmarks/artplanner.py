@@ -23,9 +23,10 @@ import numpy as np
 
 from arena.core.geometry import polyline_length
 from arena.core.types import Pose2D
+from arena.learn.planners.artplanner import ArtPlanner
 from arena.maps.grid import OccupancyGrid
 from arena.maps.terrain import terrain_course
-from arena.nav.global_planners import GLOBAL_PLANNERS, ArtPlanner
+from arena.nav.global_planners import GLOBAL_PLANNERS
 
 GO1_RADIUS = 0.347
 

@@ -88,4 +88,5 @@ def test_training_config_by_name_from_another_folder(monkeypatch, capsys, tmp_pa
     code, _, err = run_cli(monkeypatch, capsys, "train", "rosnav")
     assert code == 2
     assert err.strip() == ("error: no such file or packaged training config 'rosnav'; did you "
-                           "mean 'rosnav_rl'? packaged: applr, rlca, rosnav_rl, value_policy")
+                           "mean 'rosnav_rl'? packaged: applr, rlca, rosnav_rl, trail, "
+                           "trail_indoor, value_policy")

@@ -7,7 +7,7 @@ outside the outermost centres the edge value holds. Saved as ``heights.npz`` bes
 ``map.yaml`` (:func:`save_terrain_world`).
 
 :func:`terrain_course` draws a map with height variation for legged-robot planners
-(ArtPlanner, :mod:`arena.nav.global_planners.artplanner`): a plateau with cliffs on its sides,
+(ArtPlanner, :mod:`arena.learn.planners.artplanner`): a plateau with cliffs on its sides,
 a gentle ramp up one side and a too-steep slope up the opposite one, a low step (passable), a
 high step (not), and a rough patch. The 2-D occupancy grid holds only the border walls: the
 height variation is no obstacle in 2-D, a planner decides whether it can be walked.

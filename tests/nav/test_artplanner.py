@@ -13,9 +13,10 @@ from arena.core.geometry import polyline_length
 from arena.core.types import Pose2D
 from arena.learn.artplanner.model import ARTPLANNER_WEIGHTS, MotionCostModel
 from arena.learn.artplanner.stepping import stepping_labels, track_points
+from arena.learn.planners.artplanner import ArtPlanner
 from arena.maps.grid import OccupancyGrid
 from arena.maps.terrain import HeightMap
-from arena.nav.global_planners import GLOBAL_PLANNERS, ArtPlanner, segment_is_free
+from arena.nav.global_planners import GLOBAL_PLANNERS, segment_is_free
 
 RES = 0.1
 TOP = 0.4  # m, the plateau: higher than the robot's 0.15 m step

@@ -202,7 +202,8 @@ def test_unknown_key_and_malformed_yaml(tmp_path):
     f = _write(tmp_path, "stages:\n  - name: x\n    episodes: [1\n")
     with pytest.raises(ConfigError, match=r"malformed YAML at line \d+"):
         load_suite(f)
-    with pytest.raises(ConfigError, match="packaged: barn, barn_rgbd, indoor_people, indoor_people_rgbd, paper, quick"):
+    packaged = "packaged: barn, barn_rgbd, indoor_people, indoor_people_rgbd, paper, quick"
+    with pytest.raises(ConfigError, match=packaged):
         load_suite("papr")
 
 

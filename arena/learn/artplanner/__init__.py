@@ -4,5 +4,5 @@
 model of a Go1-sized quadruped, :mod:`.features` samples the height patch along an edge that the
 network sees, :mod:`.dataset` draws random terrain patches and edges, :mod:`.model` holds the
 MLP as a ``.npz`` file run with numpy and :mod:`.train` fits it with torch. The planner is
-:mod:`arena.nav.global_planners.artplanner`.
+:mod:`arena.learn.planners.artplanner`.
 """

@@ -4,11 +4,9 @@ Importing this package registers the built-in planners in :data:`GLOBAL_PLANNERS
 planners arrive through the ``arena.global_planners`` entry-point group.
 """
 
-from arena.nav.global_planners import artplanner as _artplanner  # noqa: F401  ("artplanner")
 from arena.nav.global_planners import astar as _astar  # noqa: F401  (registers "astar")
 from arena.nav.global_planners import dijkstra as _dijkstra  # noqa: F401  (registers "dijkstra")
 from arena.nav.global_planners import theta_star as _theta  # noqa: F401  (registers "theta_star")
-from arena.nav.global_planners.artplanner import ArtPlanner
 from arena.nav.global_planners.astar import AStarPlanner, segment_is_free
 from arena.nav.global_planners.base import (
     GLOBAL_PLANNERS,
@@ -21,7 +19,6 @@ from arena.nav.global_planners.theta_star import ThetaStarPlanner
 __all__ = [
     "GLOBAL_PLANNERS",
     "AStarPlanner",
-    "ArtPlanner",
     "DijkstraPlanner",
     "GlobalPlanner",
     "ThetaStarPlanner",

@@ -48,7 +48,11 @@ class GlobalPlanner(Protocol):
 
 
 GLOBAL_PLANNERS: Registry[GlobalPlanner] = Registry(
-    "global planner", entry_points="arena.global_planners"
+    "global planner",
+    entry_points="arena.global_planners",
+    # name -> the module registering it, imported when first named: ArtPlanner's learned motion
+    # cost lives above ``nav`` (arena.learn.planners), which ``nav`` never imports
+    builtins={"artplanner": "arena.learn.planners.artplanner"},
 )
 
 
