@@ -15,7 +15,9 @@ from __future__ import annotations
 import base64
 import io
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -52,6 +54,8 @@ class LiveScene:
         footprints: per robot its ``(k, 2)`` body-frame polygon (m; a circle as
             :data:`CIRCLE_POINTS` points for a round robot).
         lidar: robot 0's primary 2-D lidar, or ``None``.
+        lidars: per robot its 2-D lidars by sensor name (insertion-ordered; empty without).
+        primary_lidars: per robot the name of its primary lidar (the stack's), or ``None``.
     """
 
     episode: int
@@ -65,6 +69,8 @@ class LiveScene:
     robot_models: tuple[str, ...]
     footprints: tuple[FloatArray, ...]
     lidar: LidarSpec | None
+    lidars: tuple[Mapping[str, LidarSpec], ...] = ()
+    primary_lidars: tuple[str | None, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -87,6 +93,10 @@ class LiveFrame:
         groups: ``(n,)`` group id per pedestrian, -1 alone.
         collision: ``(r,)`` bool, each robot touches something.
         outcome: how the episode ended, on its last frame; ``None`` while it runs.
+        commands: ``(r, 3)`` each robot's command of the last step ``[vx m/s, vy m/s,
+            omega rad/s]`` (before limits), or ``None``.
+        lidar_scans: per robot its lidars' latest ranges by sensor name (m, ``(beams,)``
+            each; the names of :attr:`LiveScene.lidars`).
     """
 
     time: float
@@ -103,6 +113,8 @@ class LiveFrame:
     groups: IntArray
     collision: NDArray[np.bool_]
     outcome: str | None = None
+    commands: FloatArray | None = None
+    lidar_scans: tuple[Mapping[str, FloatArray], ...] = ()
 
 
 def circle_polygon(radius: float, n: int = CIRCLE_POINTS) -> FloatArray:
@@ -127,6 +139,10 @@ def scene_of(runner: EpisodeRunner) -> LiveScene:
         obstacles=tuple(np.asarray(o.polygon, dtype=np.float64) for o in world.obstacles),
         robot_names=tuple(state.robots.names), robot_models=tuple(state.robots.models),
         footprints=footprints, lidar=episode.robots[0].model.laser,
+        lidars=tuple(
+            MappingProxyType({k: v for k, v in r.model.sensors.items() if isinstance(v, LidarSpec)})
+            for r in episode.robots),
+        primary_lidars=tuple(r.model.primary_lidar for r in episode.robots),
     )
 
 
@@ -175,6 +191,11 @@ def frame_of(runner: EpisodeRunner, scene: LiveScene) -> LiveFrame:
         scan_points=scan_points(scan, robots.poses[0], scene.lidar), people=state.agents,
         groups=groups, collision=np.asarray(state.collisions.any, dtype=bool).copy(),
         outcome=None if runner.outcome is None else runner.outcome.value,
+        commands=robots.commands.copy(),
+        lidar_scans=tuple(
+            MappingProxyType({k: np.asarray(readings[k], dtype=np.float64) for k in lidars
+                              if k in readings})
+            for readings, lidars in zip(robots.sensors, scene.lidars, strict=False)),
     )
 
 
