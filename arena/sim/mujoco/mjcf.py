@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from arena.core.errors import ConfigError
-from arena.sim.mujoco.gl import choose_gl
+from arena.sim.mujoco.gl import INSTALL_HINT, choose_gl
 from arena.sim.mujoco.scene import Body, Scene3D
 from arena.sim.mujoco.terrain import HeightField
 
@@ -110,11 +110,25 @@ def import_mujoco() -> Any:
             os.environ["MUJOCO_GL"] = backend
     try:
         import mujoco
-    except ImportError:
+    except ImportError as e:
+        if e.name not in ("mujoco", None):  # a library MuJoCo's GL backend needs
+            raise _gl_import_error(e) from None
         raise ConfigError(
             "3-D worlds need the mujoco package: pip install 'arena[3d]' (mujoco==4.0.0)"
         ) from None
+    except Exception as e:  # MuJoCo loads its GL backend on import (MUJOCO_GL)
+        raise _gl_import_error(e) from None
     return mujoco
+
+
+def _gl_import_error(e: BaseException) -> ConfigError:
+    """One line for a MuJoCo import that failed in its OpenGL backend (``MUJOCO_GL``)."""
+    gl = os.environ.get("MUJOCO_GL", "")
+    first = str(e).splitlines()[0] if str(e) else ""
+    return ConfigError(
+        f"mujoco could not load its OpenGL backend MUJOCO_GL={gl!r} ({type(e).__name__}: "
+        f"{first}); unset MUJOCO_GL to let arena choose, or {INSTALL_HINT}"
+    )
 
 
 def compile_model(scene_or_xml: Scene3D | str) -> mujoco.MjModel:

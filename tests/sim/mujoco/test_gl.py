@@ -67,3 +67,22 @@ def test_glfw_without_a_display_says_to_set_mujoco_gl(monkeypatch):
     assert "set MUJOCO_GL=egl (or osmesa) before importing it" in msg and INSTALL_HINT in msg
     monkeypatch.setenv("MUJOCO_GL", "egl")
     assert "before importing it" not in str(gl_error(RuntimeError("x")))
+
+
+def test_a_mujoco_gl_that_cannot_load_is_one_line_naming_it():
+    """MuJoCo loads its GL backend on import: a bad or missing one is not a traceback."""
+    import importlib.util
+    import os
+    import subprocess
+    import sys
+
+    if importlib.util.find_spec("mujoco") is None:  # the 3d extra (installed by make test)
+        pytest.skip("mujoco is not installed")
+    code = ("from arena.core.errors import ConfigError\n"
+            "from arena.sim.mujoco.mjcf import import_mujoco\n"
+            "try:\n    import_mujoco()\nexcept ConfigError as e:\n    print(e)\n")
+    env = {**os.environ, "MUJOCO_GL": "no_such_backend"}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, check=True, timeout=120).stdout.strip()
+    assert "\n" not in out
+    assert "MUJOCO_GL='no_such_backend'" in out and "unset MUJOCO_GL" in out
