@@ -13,13 +13,13 @@ from arena.config import load_config  # noqa: E402
 from arena.core.errors import ConfigError  # noqa: E402
 from arena.experiment import run_experiment  # noqa: E402
 from arena.learn.applr.env import TRAIN_CONFIG  # noqa: E402
+from arena.learn.fit_mlp import build_mlp  # noqa: E402
 from arena.learn.lflh.actor import LflhActor, save_actor  # noqa: E402
 from arena.learn.lflh.dataset import JACKAL_LASER, DataParams, make_dataset  # noqa: E402
 from arena.learn.lflh.features import FeatureParams  # noqa: E402
 from arena.learn.lflh.hallucinate import HallucinationParams, hallucinate  # noqa: E402
 from arena.learn.lflh.motions import MotionParams, sample_motion  # noqa: E402
 from arena.learn.lflh.safety import SafetyParams, safe_command, unsafe  # noqa: E402
-from arena.learn.lflh.train import build_mlp  # noqa: E402
 from arena.learn.planners.lflh import LFLH_WEIGHTS, LflhPlanner  # noqa: E402
 from arena.maps.grid import OCCUPIED  # noqa: E402
 from arena.nav.local_planners import LOCAL_PLANNERS  # noqa: E402

@@ -160,7 +160,7 @@ def test_typed_failures_on_a_flat_map():
 
 def test_numpy_model_equals_torch_model():
     torch = pytest.importorskip("torch")
-    from arena.learn.artplanner.train import build_mlp
+    from arena.learn.fit_mlp import build_mlp
 
     model = MotionCostModel.load(ARTPLANNER_WEIGHTS)
     net = build_mlp(model.features.size, model.weights[0].shape[0])
