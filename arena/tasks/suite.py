@@ -193,6 +193,11 @@ class Contestant(_Arena):
         None, description="navigation.global_planner of this contestant (our addition), a "
         "name or a block, e.g. artplanner; default: the run's (A*)",
     )
+    navigation: dict[str, Any] = Field(
+        default_factory=dict,
+        description="other navigation settings of this contestant's stack (our addition), "
+        "merged over the run's, e.g. {oscillation_timeout: 5.0} to turn recovery on",
+    )
 
 
 class ContestFile(_Arena):
@@ -576,6 +581,13 @@ def contestant_config(
     except ConfigError as e:
         raise ConfigError(e.message, source=source, path=where) from None
     data = base_cfg.model_dump(mode="json")
+    own = sorted(set(contestant.navigation) & _OWN_KEYS)
+    if own:
+        raise ConfigError(
+            f"set {own[0]} with the contestant's own key, not under navigation",
+            source=source, path=f"contestants[{index}].navigation.{own[0]}",
+        )
+    data["navigation"] = merge(data["navigation"], contestant.navigation)
     nav = data["navigation"]
     block = {**contestant.params, "type": contestant.local_planner}
     try:
@@ -595,7 +607,18 @@ def contestant_config(
         PERCEPTION.validate(contestant.perception, source=source,
                             path=f"contestants[{index}].perception")
         nav["perception"] = contestant.perception
-    return ExperimentConfig.model_validate({**data, "name": contestant.name})
+    try:
+        return ExperimentConfig.model_validate({**data, "name": contestant.name})
+    except ValidationError as e:
+        if not contestant.navigation:
+            raise
+        err = from_validation_error(e, source=source)
+        path = (err.path or "").replace("navigation", f"contestants[{index}].navigation", 1)
+        raise ConfigError(err.message, source=source, path=path) from None
+
+
+_OWN_KEYS = frozenset({"local_planner", "global_planner", "intermediate_planner", "perception"})
+"""Navigation keys a contestant sets with its own fields, not through ``navigation``."""
 
 
 def load_benchmark(

@@ -241,6 +241,26 @@ def test_contestant_global_planner(tmp_path):
     assert e.value.path == "contestants[0].global_planner.type"
 
 
+def test_contestant_navigation_overlay(tmp_path):
+    from arena.tasks.suite import contestant_config
+
+    f = _write(tmp_path, "contestants:\n  - {name: a, local_planner: dwa, navigation: "
+               "{oscillation_timeout: 5.0, back_up_distance: 0.4}}\n", "contest.yaml")
+    nav = contestant_config(ExperimentConfig(), load_contest(f)[0].contestants[0]).navigation
+    assert nav.oscillation_timeout == 5.0 and nav.back_up_distance == 0.4
+    assert nav.local_planner["type"] == "dwa"
+    for text, path in (
+        ("{oscilation_timeout: 5.0}", "contestants[0].navigation.oscilation_timeout"),
+        ("{local_planner: {type: teb}}", "contestants[0].navigation.local_planner"),
+    ):
+        bad = _write(tmp_path, "contestants:\n  - {name: x, local_planner: dwa, navigation: "
+                     f"{text}}}\n", "bad.yaml")
+        with pytest.raises(ConfigError) as e:
+            contestant_config(ExperimentConfig(), load_contest(bad)[0].contestants[0],
+                              source=str(bad))
+        assert e.value.path == path and "\n" not in str(e.value)
+
+
 @pytest.mark.parametrize(
     "name",
     sorted(p.stem for p in (Path(arena.__file__).parent / "tasks" / "data" / "contests").glob(
