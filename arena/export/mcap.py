@@ -36,11 +36,13 @@ class McapFile:
     matches_record: bool
 
 
-def find_records(run: Path) -> list[Path]:
-    """Every episode record of a run folder (``arena bench`` or ``arena run``), sorted.
+def find_records(run: Path, only: str | None = None) -> list[Path]:
+    """The episode records of a run folder (``arena bench`` or ``arena run``), sorted.
+
+    ``only``: a glob on the records' paths relative to ``run``; ``None``: all of them.
 
     Raises:
-        ConfigError: ``run`` is no folder or holds no record.
+        ConfigError: ``run`` is no folder, holds no record, or ``only`` matches none.
     """
     if not run.is_dir():
         raise ConfigError(f"{run}: no such run folder", path="RUN")
@@ -50,6 +52,10 @@ def find_records(run: Path) -> list[Path]:
         raise ConfigError(
             f"{run}: holds no episode records (*.parquet) to export; is it an arena run or "
             "arena bench folder?", path="RUN")
+    if only is not None:
+        records = [r for r in records if fnmatch.fnmatch(str(r.relative_to(run)), only)]
+        if not records:
+            raise ConfigError(f"no record of {run} matches {only!r}", path="--only")
     return records
 
 
@@ -76,11 +82,7 @@ def export_mcap(
     fg = foxglove_module()
     src = Path(run)
     dest = Path(out) if out is not None else src / "mcap"
-    records = find_records(src)
-    if only is not None:
-        records = [r for r in records if fnmatch.fnmatch(str(r.relative_to(src)), only)]
-        if not records:
-            raise ConfigError(f"no record of {src} matches {only!r}", path="--only")
+    records = find_records(src, only)
     written = []
     for path in records:
         rel = path.relative_to(src)

@@ -14,7 +14,6 @@ place for it. Needs the ``rosbags`` package (``pip install 'arena[rosbag]'``).
 
 from __future__ import annotations
 
-import fnmatch
 import shutil
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -86,11 +85,7 @@ def export_rosbag(
     rosbags_module()
     src = Path(run)
     dest = Path(out) if out is not None else src / ("rosbag2" if flavour == "ros2" else "rosbag")
-    records = find_records(src)
-    if only is not None:
-        records = [r for r in records if fnmatch.fnmatch(str(r.relative_to(src)), only)]
-        if not records:
-            raise ConfigError(f"no record of {src} matches {only!r}", path="--only")
+    records = find_records(src, only)
     written = []
     for path in records:
         rel = path.relative_to(src)
