@@ -20,6 +20,7 @@ from arena.cli_bench import bench, report
 from arena.cli_common import PluginOption, console, err_console, load_plugin_options
 from arena.cli_compare import compare
 from arena.cli_export import export_app
+from arena.cli_ros import ros2_app
 from arena.cli_world import maps_app, scenario_app, tasks_app
 from arena.core.errors import ArenaError, ConfigError
 
@@ -137,8 +138,12 @@ def run(
 
 
 def _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, interactive,
-         plugin, session, *, resume: bool = False) -> None:
-    """The body of ``arena run`` (its options as arguments, ``session`` its live setup)."""
+         plugin, session, *, resume: bool = False, realtime: bool = False) -> None:
+    """The body of ``arena run`` (its options as arguments, ``session`` its live setup).
+
+    ``realtime`` paces the run to wall-clock time without ``--interactive``'s stdin commands
+    (``arena ros2 run``).
+    """
     from rich.markup import escape
 
     from arena.config import load_config
@@ -218,7 +223,7 @@ def _run(config, overrides, episodes, robot, map_, seed, out, video, scenario, i
     with bar:
         out_dir, results = run_experiment(
             cfg, out, on_episode=show, modules=extra_modules,
-            realtime=interactive and not session.hooks,  # a live view paces the run itself
+            realtime=(interactive or realtime) and not session.hooks,  # a live view paces itself
             on_step=on_step, hooks=session.hooks, on_start=session.on_start, resume=resume,
         )
     console.print(table)
@@ -307,6 +312,7 @@ app.add_typer(maps_app, name="maps")
 app.add_typer(scenario_app, name="scenario")
 app.add_typer(tasks_app, name="tasks")
 app.add_typer(export_app, name="export")
+app.add_typer(ros2_app, name="ros2")
 app.command()(bench)
 
 

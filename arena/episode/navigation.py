@@ -75,7 +75,9 @@ class NavigationController(EpisodeHooks):
     ``goal_reached`` is noted; a forced reset ends the episode as ``aborted``; the task done
     ends it as ``success``; teleports move the robots (the stack plans afresh for robot 0) and
     a new goal makes it replan. Then the stack computes the command; when it reports ``STUCK``
-    (every recovery behaviour tried) the episode ends as ``stuck``.
+    (every recovery behaviour tried) the episode ends as ``stuck``. A local planner that is
+    itself an :class:`~arena.episode.runner.EpisodeHooks` (the ROS planners, which send the
+    episode's frames) gets every hook call after the controller's own.
 
     Args:
         stack: robot 0's navigation stack (:func:`build_stack`).
@@ -114,6 +116,9 @@ class NavigationController(EpisodeHooks):
         self.goal: Pose2D | None = None
         self.control_s: list[float] = []
         self.perceived: list[tuple[float, Perceived]] = []
+        # a local planner that follows the episode itself (the ROS planners send its frames)
+        planner = getattr(stack, "local_planner", None)
+        self._planner_hooks = [planner] if isinstance(planner, EpisodeHooks) else []
 
     def initialize_episode(self, runner: EpisodeRunner) -> None:
         """Plan from robot 0's start to its goal."""
@@ -124,6 +129,18 @@ class NavigationController(EpisodeHooks):
         self.perceived = []
         self.perception.reset()
         self.stack.reset(planning_grid(runner.episode), spawn.start, self.goal)
+        for hook in self._planner_hooks:
+            hook.initialize_episode(runner)
+
+    def after_step(self, runner: EpisodeRunner) -> None:
+        """Forward to a local planner that follows the episode."""
+        for hook in self._planner_hooks:
+            hook.after_step(runner)
+
+    def episode_end(self, runner: EpisodeRunner) -> None:
+        """Forward to a local planner that follows the episode."""
+        for hook in self._planner_hooks:
+            hook.episode_end(runner)
 
     def before_step(self, runner: EpisodeRunner) -> None:
         """Apply the task's update (see the class doc)."""
@@ -153,6 +170,8 @@ class NavigationController(EpisodeHooks):
                 planning_grid(episode), Pose2D.from_array(state.robots.poses[0]), self.goal,
                 time=state.time,
             )
+        for hook in self._planner_hooks:
+            hook.before_step(runner)
 
     def command(self, runner: EpisodeRunner) -> FloatArray:
         """The stack's ``(1, 3)`` command for robot 0 (the episode ends on ``STUCK``)."""

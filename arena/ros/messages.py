@@ -226,15 +226,27 @@ class RosMessages:
         return [(by_kind["tf_static"], 0, {"transforms": static}),
                 (by_kind["map"], 0, occupancy_grid(scene, 0))]
 
-    def frame(self, frame: LiveFrame) -> list[Message]:
-        """The messages of one step (none for a repeat of the last step's frame)."""
+    def frame(self, frame: LiveFrame, *, only: set[str] | None = None,
+              repeat: bool = False) -> list[Message]:
+        """The messages of one step (none for a repeat of the last step's frame).
+
+        Args:
+            frame: the step.
+            only: build only the topics of these names (``None``: all).
+            repeat: build a repeat of the last step too (a live bridge sends it again to a
+                node that subscribed late).
+        """
         scene = self._scene
-        if scene is None or frame.step == self._last_step:
+        if scene is None or (frame.step == self._last_step and not repeat):
             return []  # the episode's last frame repeats its last step (with the outcome)
+        if repeat and frame.step == self._last_step:
+            self._last_scan = {k: t for k, t in self._last_scan.items() if t < frame.time}
         self._last_step = frame.step
         ns = sim_ns(frame.time)
         out: list[Message] = []
         for topic in self.table:
+            if only is not None and topic.name not in only:
+                continue
             fields = self._message(topic, scene, frame, ns)
             if fields is not None:
                 out.append((topic, ns, fields))

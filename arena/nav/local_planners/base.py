@@ -179,6 +179,8 @@ _BUILTIN_PLANNERS = {
     "lflh": _LEARNED + "lflh",
     "trail": _LEARNED + "trail",
     "iplanner": _LEARNED + "iplanner",
+    # an external ROS node (arena.ros is above nav: it uses the episode runner's frames)
+    "ros2": "arena.ros.planner",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(

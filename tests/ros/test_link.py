@@ -1,0 +1,210 @@
+"""The ROS link and planner over an in-memory node: lock-step, topics, goals, timeouts.
+
+No ROS library and no network: :class:`arena.testing.ros.LoopbackTransport` plays the node.
+The same link over rclpy and rospy is tested in test_ros2_bridge.py / test_ros1_bridge.py.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+import arena.plugins  # noqa: F401  (fills the registries)
+from arena.config import load_config
+from arena.core.errors import ConfigError
+from arena.core.types import Outcome, Pose2D
+from arena.crowd.driver import build_driver
+from arena.episode.navigation import NavigationController, build_stack
+from arena.episode.runner import EpisodeRunner
+from arena.nav.local_planners.base import LOCAL_PLANNERS
+from arena.robots.presets import load_robot
+from arena.ros.link import LinkOptions, check_namespace
+from arena.ros.nodes.pursuit import PursuitParams, pursuit_command
+from arena.ros.planner import Ros2Planner, RosPlannerParams
+from arena.sim.native2d import Native2DBackend
+from arena.tasks.generator import TaskRuntime
+from arena.tasks.modules.interactive import InteractiveModule
+from arena.testing.ros import LoopbackTransport, attach_loopback
+from tests.conftest import make_episode
+
+
+def _pose(odom: dict) -> np.ndarray:
+    p, q = odom["pose"]["pose"]["position"], odom["pose"]["pose"]["orientation"]
+    return np.array([p["x"], p["y"], 2 * math.atan2(q["z"], q["w"])])
+
+
+def pursuit_node(sent: dict) -> np.ndarray | None:
+    """The example node's rule on the latest odom, plan and goal it was sent."""
+    if not sent.get("/odom"):
+        return None
+    plan = np.array([[p["pose"]["position"]["x"], p["pose"]["position"]["y"]]
+                     for p in sent["/plan"][-1]["poses"]]) if sent.get("/plan") else np.zeros((0, 2))
+    goal = sent.get("/goal_pose")
+    yaw = None if not goal else 2 * math.atan2(goal[-1]["pose"]["orientation"]["z"],
+                                               goal[-1]["pose"]["orientation"]["w"])
+    v, w = pursuit_command(_pose(sent["/odom"][-1]), plan, None, PursuitParams(), yaw)
+    return np.array([v, 0.0, w])
+
+
+def _runner(room, planner, *, modules=(), time_limit=30.0, goal=(8.0, 5.0, 0.0)):
+    jackal = load_robot("jackal")
+    episode = make_episode(room, [(jackal, (2.0, 5.0, 0.0), goal)], time_limit=time_limit)
+    cfg = load_config(None, ["output.video=false"])
+    stack = build_stack(cfg.navigation, jackal, episode, local_planner=planner)
+    nav = NavigationController(stack, TaskRuntime.single_goal(episode, modules=modules), jackal)
+    runner = EpisodeRunner(Native2DBackend(), 0.1, [nav], nav)
+    runner.reset(episode, build_driver({"type": "pysocial"}, None), seed=0)
+    return runner
+
+
+def _planner(**params) -> Ros2Planner:
+    return Ros2Planner(RosPlannerParams(**params))
+
+
+def test_lockstep_episode_with_a_pursuit_node_reaches_the_goal(room):
+    planner = attach_loopback(_planner(), reply=pursuit_node)
+    runner = _runner(room, planner)
+    assert runner.run() is Outcome.SUCCESS
+    sent = planner.link.transport.sent
+    ticks = runner.ticks
+    # one odom per frame: the first at reset, then one per step (the last repeats no step)
+    assert len(sent["/odom"]) == ticks + 1
+    assert [m["header"]["stamp"] for m in sent["/odom"][:3]] == [
+        {"sec": 0, "nanosec": 0}, {"sec": 0, "nanosec": 100_000_000},
+        {"sec": 0, "nanosec": 200_000_000}]
+    assert "/cmd_vel" not in sent  # the node's topic: the link subscribes it, never publishes
+    assert len(sent["/goal_pose"]) == 1  # sent when it changes, not every step
+    assert len(sent["/map"]) == len(sent["/tf_static"]) == 1
+    assert len(sent["/clock"]) == ticks + 1
+    assert runner.state.robots.poses[0][0] > 7.5
+
+
+def test_each_command_answers_the_latest_frame(room):
+    """Lock-step: the robot's command at step k is the node's answer to frame k."""
+    answers: list[np.ndarray] = []
+
+    def node(sent):
+        k = len(sent.get("/odom", []))
+        cmd = np.array([0.1 * (k % 5), 0.0, 0.0])
+        answers.append(cmd)
+        return cmd
+
+    planner = attach_loopback(_planner(), reply=node)
+    runner = _runner(room, planner, time_limit=2.0)
+    runner.run()
+    robots = runner.state.robots
+    assert robots.commands[0][0] == pytest.approx(answers[-1][0])
+    assert len(answers) == runner.ticks  # one poll per tick: the answer came at once
+
+
+def test_a_silent_node_ends_the_episode_as_error_and_the_next_runs(room):
+    planner = attach_loopback(_planner(timeout=0.05, startup_timeout=0.05),
+                              reply=lambda sent: None)
+    runner = _runner(room, planner)
+    assert runner.run() is Outcome.ERROR
+    assert runner.error.startswith("NodeTimeout: no /cmd_vel command within 0.05 s")
+    planner.link.transport.reply = pursuit_node  # the node comes back: the next episode runs
+    runner2 = _runner(room, planner)
+    assert runner2.run() is Outcome.SUCCESS
+
+
+def test_unsubscribed_topics_are_not_built_and_a_late_subscriber_gets_the_frame(room):
+    planner = attach_loopback(_planner(), reply=pursuit_node, subscribed={"/odom", "/plan"})
+    runner = _runner(room, planner, time_limit=1.0)
+    runner.run()
+    sent = planner.link.transport.sent
+    assert "/people/markers" not in sent and "/scan" not in sent
+    assert len(sent["/map"]) == 1  # latched: sent for late subscribers anyway
+
+
+def test_goals_from_ros_reach_the_interactive_module(room):
+    ui = InteractiveModule()
+    planner = attach_loopback(_planner(), reply=pursuit_node)
+    runner = _runner(room, planner, modules=[ui], time_limit=60.0)
+    runner.tick()
+    planner.link.on_goal(Pose2D(3.0, 8.0, 0.0))
+    planner.link.on_goal(Pose2D(*runner.controller.goal.as_array()))  # its own goal echoed
+    assert runner.run() is Outcome.SUCCESS
+    assert [e[1] for e in runner.events].count("new_goal") == 1
+    assert np.allclose(runner.state.robots.poses[0][:2], [3.0, 8.0], atol=0.35)
+
+
+def test_a_benchmark_ignores_goals_and_resets_from_ros(room):
+    planner = attach_loopback(_planner(), reply=pursuit_node)
+    runner = _runner(room, planner)
+    runner.tick()
+    planner.link.on_goal(Pose2D(3.0, 8.0, 0.0))
+    planner.link.on_reset()
+    assert runner.run() is Outcome.SUCCESS
+    assert any(kind == "ros_ignored" for _, kind, _ in runner.events)
+
+
+def test_reset_ends_the_episode_through_the_interactive_module(room):
+    ui = InteractiveModule()
+    planner = attach_loopback(_planner(), reply=pursuit_node)
+    runner = _runner(room, planner, modules=[ui])
+    runner.tick()
+    assert planner.link.on_reset()[0]
+    assert runner.run() is Outcome.ABORTED
+
+
+def test_realtime_takes_the_latest_command_and_stops_on_a_stale_one():
+    from arena.testing.ros import loopback_link
+
+    link = loopback_link(LinkOptions(mode="realtime", command_timeout=1e-9),
+                         reply=lambda sent: None)
+    assert np.array_equal(link.command(), np.zeros(3))  # nothing yet: stop
+    link.on_command(np.array([0.5, 0.0, 0.1]))
+    assert np.array_equal(link.command(), np.zeros(3))  # older than the timeout: stop
+    link2 = loopback_link(LinkOptions(mode="realtime", command_timeout=60.0),
+                          reply=lambda sent: None)
+    link2.on_command(np.array([0.5, 0.0, 0.1]))
+    assert np.array_equal(link2.command(), [0.5, 0.0, 0.1])
+
+
+def test_commands_are_clipped_to_the_robot(room):
+    planner = attach_loopback(_planner(), reply=lambda sent: np.array([9.0, 3.0, 9.0]))
+    runner = _runner(room, planner, time_limit=3.0)
+    runner.run()
+    lim = load_robot("jackal").limits()
+    cmds = runner.state.robots.commands[0]
+    assert cmds[0] <= lim.vx_max + 1e-9 and cmds[1] == 0.0
+
+
+def test_outside_a_runner_the_planner_says_what_it_needs():
+    from arena.nav.local_planners.base import LocalObservation
+
+    obs = LocalObservation(pose=np.zeros(3), twist=np.zeros(3), goal=np.array([3.0, 0.0, 0.0]),
+                           path=np.array([[0.0, 0.0], [3.0, 0.0]]),
+                           limits=load_robot("jackal").limits(), robot_radius=0.3, dt=0.1)
+    with pytest.raises(ConfigError, match="needs an episode runner"):
+        _planner().compute(obs)
+
+
+@pytest.mark.parametrize(("spec", "message"), [
+    ({"namespace": "robot 1"}, "not a ROS namespace"),
+    ({"mode": "fast"}, "mode"),
+    ({"timeout": 0}, "timeout"),
+    ({"launch": []}, "launch"),
+    ({"tmeout": 3}, "tmeout"),
+])
+def test_bad_parameters_are_one_line_errors(spec, message):
+    with pytest.raises(ConfigError, match=message) as err:
+        LOCAL_PLANNERS.build({"type": "ros2", **spec}, path="navigation.local_planner")
+    assert "\n" not in str(err.value)
+
+
+def test_namespaces():
+    assert check_namespace("") == ""
+    assert check_namespace("/arena_12/") == "/arena_12"
+    with pytest.raises(ConfigError):
+        check_namespace("no_slash")
+    assert RosPlannerParams(namespace="auto").link_options().namespace.startswith("/arena_")
+
+
+def test_transport_records_like_a_node():
+    from arena.testing.ros import loopback_link
+
+    link = loopback_link()
+    assert isinstance(link.transport, LoopbackTransport)
+    assert link.transport.subscribers("/odom") == 0  # not advertised yet
