@@ -8,6 +8,7 @@ a timeout bounds the whole run. The scenario prints its result as JSON on its la
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -64,10 +65,8 @@ def run_isolated(script: Path, case: str, *args: str, env: dict[str, str] | None
         out, err = proc.communicate()
         pytest.fail(f"{script.name} {case} ran over {timeout:g} s:\n{err[-3000:]}")
     finally:
-        try:
+        with contextlib.suppress(ProcessLookupError):
             os.killpg(proc.pid, signal.SIGKILL)  # whatever it left behind
-        except ProcessLookupError:
-            pass
     lines = out.strip().splitlines()
     if proc.returncode != 0 or not lines:
         pytest.fail(f"{script.name} {case} failed ({proc.returncode}):\n{err[-3000:]}")

@@ -37,8 +37,9 @@ def pursuit_node(sent: dict) -> np.ndarray | None:
     """The example node's rule on the latest odom, plan and goal it was sent."""
     if not sent.get("/odom"):
         return None
-    plan = np.array([[p["pose"]["position"]["x"], p["pose"]["position"]["y"]]
-                     for p in sent["/plan"][-1]["poses"]]) if sent.get("/plan") else np.zeros((0, 2))
+    poses = sent["/plan"][-1]["poses"] if sent.get("/plan") else []
+    plan = np.array([[p["pose"]["position"]["x"], p["pose"]["position"]["y"]] for p in poses])
+    plan = plan.reshape(-1, 2)
     goal = sent.get("/goal_pose")
     yaw = None if not goal else 2 * math.atan2(goal[-1]["pose"]["orientation"]["z"],
                                                goal[-1]["pose"]["orientation"]["w"])
