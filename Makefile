@@ -19,6 +19,7 @@ $(STAMP): pyproject.toml | $(PY)
 $(TEST_STAMP): pyproject.toml | $(PY)
 	$(PY) -m pip install --quiet torch==2.13.0  # first: the CPU build, before SB3 asks for torch
 	$(PY) -m pip install --quiet -e ".[test]"
+	$(VENV)/bin/arena ros2 setup  # tf2_msgs for the ROS 2 bridge tests (~5 s, cmake + g++)
 	touch $@ $(STAMP)
 
 ## run: create .venv, install Arena and run the main job: the packaged quick benchmark
