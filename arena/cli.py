@@ -21,6 +21,7 @@ from arena.cli_common import PluginOption, console, err_console, load_plugin_opt
 from arena.cli_compare import compare
 from arena.cli_export import export_app
 from arena.cli_ros import ros2_app
+from arena.cli_ros1 import ros1_app
 from arena.cli_world import maps_app, scenario_app, tasks_app
 from arena.core.errors import ArenaError, ConfigError
 
@@ -313,6 +314,7 @@ app.add_typer(scenario_app, name="scenario")
 app.add_typer(tasks_app, name="tasks")
 app.add_typer(export_app, name="export")
 app.add_typer(ros2_app, name="ros2")
+app.add_typer(ros1_app, name="ros1")
 app.command()(bench)
 
 

@@ -278,3 +278,19 @@ class Ros2Planner(RosPlanner):
     def remap_args(namespace: str) -> list[str]:
         """``--ros-args -r __ns:=<namespace>``."""
         return ["--ros-args", "-r", f"__ns:={namespace}"]
+
+
+@LOCAL_PLANNERS.register("ros1", tags=("ros", "external"))
+class Ros1Planner(RosPlanner):
+    """An external ROS 1 node drives the robot over Arena's ROS 1 topics.
+
+    Needs Debian's ROS 1 (``bash tools/install_ros1.sh``) and a ROS master at
+    ``ROS_MASTER_URI``.
+    """
+
+    transport = ("arena.ros.ros1", "Ros1Transport")
+
+    @staticmethod
+    def remap_args(namespace: str) -> list[str]:
+        """``__ns:=<namespace>`` (rospy's command-line remapping)."""
+        return [f"__ns:={namespace}"]

@@ -181,6 +181,7 @@ _BUILTIN_PLANNERS = {
     "iplanner": _LEARNED + "iplanner",
     # an external ROS node (arena.ros is above nav: it uses the episode runner's frames)
     "ros2": "arena.ros.planner",
+    "ros1": "arena.ros.planner",
 }
 
 LOCAL_PLANNERS: Registry[LocalPlanner] = Registry(
