@@ -8,7 +8,8 @@ node) with every metric and the report::
 
     contestants:
       - name: my_ros_planner
-        local_planner: {type: ros2, launch: [python, -m, my_pkg.my_node], namespace: auto}
+        local_planner: ros2
+        params: {launch: [python, -m, my_pkg.my_node], namespace: auto}
 
 ``launch`` starts the node with the first episode and stops it when the process ends (one node
 per benchmark worker, re-used by its episodes; ``python`` means this interpreter). The node

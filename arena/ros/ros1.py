@@ -4,7 +4,8 @@ One rospy node per process (rospy allows one ``init_node``), named ``arena`` (``
 when a node of that name is already registered, as in a benchmark's parallel workers: the
 master would otherwise shut the first one down), made on first use with
 ``disable_signals=True`` and shared by every link the process opens; each link has its own
-publishers, subscribers and service, unregistered when it closes. rospy runs callbacks in its
+publishers and subscribers, unregistered when it closes (the reset service is offered once per
+name and answered by the latest open link of that namespace). rospy runs callbacks in its
 own threads: goals and resets go to the link from there (thread-safe); commands wait for
 :meth:`Ros1Transport.poll`, on the link's thread, as rclpy's callbacks do.
 
@@ -30,7 +31,7 @@ import math
 import threading
 import warnings
 from functools import cache
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -114,9 +115,16 @@ def _yaw(q: Any) -> float:
 
 
 class _Process:
-    """The process's rospy node (made once; rospy shuts it down at exit)."""
+    """The process's rospy node (made once; rospy shuts it down at exit) and its services.
+
+    rospy lets a node offer a service name once, but a process may hold two links of one
+    namespace (two planner configurations, or a benchmark's contestants, in one worker): each
+    service is offered once and answered by the latest open link that asked for it.
+    """
 
     rospy: Any = None
+    _lock = threading.Lock()
+    _services: ClassVar[dict[str, tuple[Any, list[Ros1Transport]]]] = {}
 
     @classmethod
     def get(cls) -> Any:
@@ -132,6 +140,33 @@ class _Process:
             cls.rospy = rospy
         return cls.rospy
 
+    @classmethod
+    def serve_reset(cls, name: str, transport: Ros1Transport) -> None:
+        """Let ``transport`` answer the ``std_srvs/Trigger`` service ``name``."""
+        from std_srvs.srv import Trigger
+
+        with cls._lock:
+            if name not in cls._services:
+                service = cls.rospy.Service(name, Trigger, lambda req: cls._answer(name, req))
+                cls._services[name] = (service, [])
+            cls._services[name][1].append(transport)
+
+    @classmethod
+    def unserve_reset(cls, name: str, transport: Ros1Transport) -> None:
+        """``transport`` no longer answers ``name``; the last one gone, the service goes."""
+        with cls._lock:
+            service, users = cls._services[name]
+            users.remove(transport)
+            if not users:
+                del cls._services[name]
+                service.shutdown("link closed")
+
+    @classmethod
+    def _answer(cls, name: str, request: Any) -> Any:
+        with cls._lock:
+            transport = cls._services[name][1][-1]
+        return transport._on_reset(request)
+
 
 class Ros1Transport:
     """rospy side of one :class:`~arena.ros.link.RosLink` (see the module doc).
@@ -146,9 +181,10 @@ class Ros1Transport:
 
     def __init__(self, link: RosLink) -> None:
         rospy = _Process.get()
-        from std_srvs.srv import Trigger, TriggerResponse
+        from std_srvs.srv import TriggerResponse
 
         self.link = link
+        self._node = rospy.get_name()  # before the subscribers: their callbacks read it
         self._response = TriggerResponse
         self._arrived = threading.Event()
         self._lock = threading.Lock()
@@ -165,9 +201,9 @@ class Ros1Transport:
             rospy.Subscriber(opts.name("/goal_pose"), message_class("geometry_msgs/PoseStamped"),
                              self._on_goal, queue_size=10),
         ]
-        self._service: Any = rospy.Service(opts.name("/arena/reset"), Trigger, self._on_reset)
+        self._service = opts.name("/arena/reset")
+        _Process.serve_reset(self._service, self)
         self._rospy: Any = rospy
-        self._node = rospy.get_name()
 
     # -- Transport ------------------------------------------------------------------------------
     def advertise(self, topic: Topic, name: str) -> None:
@@ -226,7 +262,7 @@ class Ros1Transport:
             pub.unregister()
         for sub in self._subscribers:
             sub.unregister()
-        self._service.shutdown("link closed")
+        _Process.unserve_reset(self._service, self)
         self._publishers, self._subscribers, self._rospy = {}, [], None
 
     # -- callbacks (rospy's threads) ----------------------------------------------------------

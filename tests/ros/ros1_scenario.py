@@ -104,10 +104,26 @@ def roundtrip() -> dict[str, Any]:
     again = RosLink(Ros1Transport, LinkOptions(namespace="/second"))
     again.scene(scene())
     reopened = graph()
+    # a third of the same namespace: the reset service goes to the latest open link
+    twin = RosLink(Ros1Transport, LinkOptions(namespace="/second"))
+    served = reset_calls("/second/arena/reset", twin, again)
+    twin.close()
+    served += reset_calls("/second/arena/reset", again)
     again.close()
     return {"commands": [first, second], "goals": [[g.x, g.y, g.theta] for g in goals],
             "resets": resets[0], "peer": json.loads(out.strip().splitlines()[-1]),
-            "graph_closed": closed.get("/arena", []), "graph_reopened": reopened.get("/arena", [])}
+            "graph_closed": closed.get("/arena", []), "graph_reopened": reopened.get("/arena", []),
+            "served": served, "graph_last": graph().get("/arena", [])}
+
+
+def reset_calls(service: str, *links: RosLink) -> list[int]:
+    """Call ``service`` once; the resets each of ``links`` counted."""
+    import rospy
+    from std_srvs.srv import Trigger
+
+    rospy.wait_for_service(service, timeout=WAIT_S)
+    rospy.ServiceProxy(service, Trigger)()
+    return [link.take_resets() for link in links]
 
 
 def episode(out: str, episodes: str = "2") -> dict[str, Any]:

@@ -135,6 +135,9 @@ def test_a_closed_link_leaves_the_graph_and_the_node_serves_the_next(roundtrip):
     reopened = roundtrip["graph_reopened"]  # the same node /arena, the new link's namespace
     assert {"pub /second/map", "pub /second/scan", "sub /second/cmd_vel",
             "srv /second/arena/reset"} <= set(reopened)
+    # two links of one namespace share the reset service: the latest open one answers
+    assert roundtrip["served"] == [1, 0, 1]
+    assert not [e for e in roundtrip["graph_last"] if "second" in e]
 
 
 def test_arena_ros1_run_in_lock_step_reaches_the_goals_with_a_rospy_node(tmp_path):
