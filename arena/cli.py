@@ -20,8 +20,7 @@ from arena.cli_bench import bench, report
 from arena.cli_common import PluginOption, console, err_console, load_plugin_options
 from arena.cli_compare import compare
 from arena.cli_export import export_app
-from arena.cli_ros import ros2_app
-from arena.cli_ros1 import ros1_app
+from arena.cli_ros import ros1_app, ros2_app
 from arena.cli_world import maps_app, scenario_app, tasks_app
 from arena.core.errors import ArenaError, ConfigError
 

@@ -49,6 +49,8 @@ from arena.ros.topics import Topic
 Mode = Literal["lockstep", "realtime"]
 #: s between repeats of an unanswered episode's latest frame (a node still discovering).
 RESEND_S = 0.25
+#: s of silence after which the latest frame goes again to every subscribed topic.
+RESEND_ALL_S = 1.0
 FloatArray = NDArray[np.float64]
 
 
@@ -100,6 +102,8 @@ class LinkOptions:
         cmd_vel_stamped: ``cmd_vel`` is ``geometry_msgs/TwistStamped`` (Nav2's
             ``enable_stamped_cmd_vel``) instead of ``Twist``.
         clock: publish ``/clock`` (simulated time, for nodes with ``use_sim_time``).
+        remap: ``(default name, name)`` pairs: a topic (or ``/arena/reset``) of the table under
+            another absolute name (``("/scan", "/front/scan")``); the namespace does not apply.
     """
 
     mode: Mode = "lockstep"
@@ -109,9 +113,13 @@ class LinkOptions:
     command_timeout: float = 0.5
     cmd_vel_stamped: bool = False
     clock: bool = True
+    remap: tuple[tuple[str, str], ...] = ()
 
     def name(self, topic: str) -> str:
-        """``topic`` in the link's namespace."""
+        """``topic`` in the link's namespace, or where :attr:`remap` sends it."""
+        for source, target in self.remap:
+            if source == topic:
+                return target
         return f"{self.namespace}{topic}"
 
 
@@ -172,20 +180,23 @@ class RosLink:
     def frame(self, frame: LiveFrame, *, last: bool = False) -> None:
         """Send one step's messages on the topics someone subscribes to."""
         self._send(frame, repeat=False)
-        with self._cond:
-            self._frames += 1
 
-    def _send(self, frame: LiveFrame, *, repeat: bool) -> None:
+    def _send(self, frame: LiveFrame, *, repeat: bool, everything: bool = False) -> None:
         """Send ``frame`` on the subscribed topics.
 
-        A repeat goes only to topics that gained a subscriber since (a node answering each
-        ``odom`` must get each frame exactly once).
+        A new frame counts as sent just before its last message (``odom``) goes out: an
+        answer can only follow that one, and a client library that runs callbacks on its own
+        threads (rospy) may deliver it before ``publish`` returns. A repeat goes only to topics
+        that gained a subscriber since (a node answering each ``odom`` must get each frame
+        once), or to every subscribed topic with ``everything`` (a node still silent after
+        :data:`RESEND_ALL_S`: its first answer may have gone out before it was connected).
         """
         self._last_frame = frame
         transport, opts = self.transport, self.options
         counts = {t.name: transport.subscribers(opts.name(t.name)) for t in self.messages.table}
         if repeat:
-            wanted = {n for n, c in counts.items() if c > self._reached.get(n, 0)}
+            wanted = {n for n, c in counts.items()
+                      if c > (0 if everything else self._reached.get(n, 0))}
             if not wanted:
                 return
         else:
@@ -201,8 +212,16 @@ class RosLink:
         messages = self.messages.frame(frame, only=wanted, repeat=repeat)
         # odom last: a node that answers each odom has the frame's scan, plan and goal by then
         messages.sort(key=lambda m: m[0].kind == "odom")
-        for topic, _, fields in messages:
+        for k, (topic, _, fields) in enumerate(messages):
+            if not repeat and k == len(messages) - 1:
+                self._count_frame()
             transport.publish(topic, opts.name(topic.name), fields)
+        if not repeat and not messages:
+            self._count_frame()
+
+    def _count_frame(self) -> None:
+        with self._cond:
+            self._frames += 1
 
     # -- incoming (any thread) ------------------------------------------------------------------
     def on_command(self, command: FloatArray, stamp_ns: int | None = None) -> None:
@@ -263,6 +282,7 @@ class RosLink:
         wait = opts.timeout if self._answered else opts.startup_timeout
         deadline = time.monotonic() + wait
         resend = time.monotonic() + RESEND_S
+        resend_all = time.monotonic() + RESEND_ALL_S
         while True:
             with self._cond:
                 inbox = self._inbox
@@ -274,8 +294,11 @@ class RosLink:
             left = deadline - now
             if not self._answered and self._last_frame is not None and now >= resend:
                 # a node that subscribed after the frame went out gets it now
-                self._send(self._last_frame, repeat=True)
+                everything = now >= resend_all
+                self._send(self._last_frame, repeat=True, everything=everything)
                 resend = now + RESEND_S
+                if everything:
+                    resend_all = now + RESEND_ALL_S
             if left <= 0:
                 raise NodeTimeout(
                     f"no {opts.name('/cmd_vel')} command within {wait:g} s (lock-step, after "
@@ -285,6 +308,22 @@ class RosLink:
     def close(self) -> None:
         """Close the transport."""
         self.transport.close()
+
+
+def check_topic(name: str, *, field_name: str = "remap") -> str:
+    """An absolute ROS name ``/a/b`` (letters, digits, underscores; no part starts with a digit).
+
+    Raises:
+        ConfigError: anything else.
+    """
+    try:
+        ok = name.startswith("/") and not name.endswith("/") and check_namespace(name) == name
+    except ConfigError:
+        ok = False
+    if not ok:
+        raise ConfigError(f"{field_name}: {name!r} is not an absolute ROS name (expected "
+                          "'/name' or '/a/b')")
+    return name
 
 
 def check_namespace(namespace: str, *, field_name: str = "namespace") -> str:

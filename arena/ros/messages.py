@@ -22,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from arena.core.types import Pose2D
 from arena.live.frame import LiveFrame, LiveScene
 from arena.render.style import agent_state_color
 from arena.ros.topics import MAP_FRAME, RobotNames, Topic, robot_names, topic_table
@@ -70,6 +71,17 @@ def vector(x: float = 0.0, y: float = 0.0, z: float = 0.0) -> Fields:
 def yaw_quaternion(yaw: float) -> Fields:
     """``geometry_msgs/Quaternion`` of a rotation by ``yaw`` rad about z."""
     return {"x": 0.0, "y": 0.0, "z": math.sin(yaw / 2), "w": math.cos(yaw / 2)}
+
+
+def quaternion_yaw(q: Any) -> float:
+    """Yaw (rad) of a received ``geometry_msgs/Quaternion`` (any object with x, y, z, w)."""
+    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
+
+
+def received_pose(msg: Any) -> Pose2D:
+    """The planar pose of a received ``geometry_msgs/Pose``."""
+    p = msg.position
+    return Pose2D(float(p.x), float(p.y), quaternion_yaw(msg.orientation))
 
 
 def pose(x: float, y: float, yaw: float, z: float = 0.0) -> Fields:

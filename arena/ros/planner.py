@@ -13,7 +13,8 @@ node) with every metric and the report::
 
 ``launch`` starts the node with the first episode and stops it when the process ends (one node
 per benchmark worker, re-used by its episodes; ``python`` means this interpreter). The node
-gets ``--ros-args -r __ns:=<namespace>`` (ROS 1: ``__ns:=<namespace>``) when a namespace is set;
+gets ``--ros-args -r __ns:=<namespace>`` (ROS 1: ``__ns:=<namespace>``) when a namespace is set,
+and its ``/clock``, ``/tf`` and ``/tf_static`` remapped into the namespace, where Arena sends them;
 ``namespace: auto`` gives each worker process its own (``/arena_<pid>``), so parallel workers
 do not hear each other. A node started by hand uses the default ``""``.
 
@@ -45,7 +46,7 @@ from arena.episode.runner import EpisodeHooks, EpisodeRunner
 from arena.live.hook import LiveHook
 from arena.nav.local_planners.base import KINEMATICS, LOCAL_PLANNERS, LocalObservation
 from arena.nav.local_planners.path_tracking import finish_command
-from arena.ros.link import LinkOptions, RosLink, Transport, check_namespace
+from arena.ros.link import LinkOptions, RosLink, Transport, check_namespace, check_topic
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -53,6 +54,9 @@ if TYPE_CHECKING:
 FloatArray = NDArray[np.float64]
 #: s to wait for a launched node to stop after SIGTERM before it is killed.
 STOP_WAIT_S = 3.0
+#: Absolute topics a node reads outside its namespace (sim time, tf): a launched node in a
+#: namespace gets them remapped into it, where Arena sends them.
+ABSOLUTE = ("/clock", "/tf", "/tf_static")
 
 
 class RosPlannerParams(BaseModel):
@@ -81,6 +85,15 @@ class RosPlannerParams(BaseModel):
     cmd_vel_stamped: bool = False
     clock: bool = True
     launch: list[str] | None = None
+    remap: dict[str, str] = Field(default_factory=dict)
+
+    @field_validator("remap")
+    @classmethod
+    def _remap(cls, v: dict[str, str]) -> dict[str, str]:
+        for source, target in v.items():
+            check_topic(source, field_name=f"remap key {source!r}")
+            check_topic(target, field_name=f"remap[{source!r}]")
+        return v
 
     @field_validator("namespace")
     @classmethod
@@ -100,7 +113,8 @@ class RosPlannerParams(BaseModel):
         return LinkOptions(mode=self.mode, namespace=ns, timeout=self.timeout,
                            startup_timeout=self.startup_timeout,
                            command_timeout=self.command_timeout,
-                           cmd_vel_stamped=self.cmd_vel_stamped, clock=self.clock)
+                           cmd_vel_stamped=self.cmd_vel_stamped, clock=self.clock,
+                           remap=tuple(sorted(self.remap.items())))
 
 
 class _Shared:
@@ -127,7 +141,8 @@ class _Shared:
         if proc is not None and proc.poll() is None:
             return
         try:
-            cls.nodes[key] = subprocess.Popen(argv, start_new_session=True)
+            cls.nodes[key] = subprocess.Popen(argv, start_new_session=True,
+                                              preexec_fn=_die_with_parent)
         except OSError as e:
             raise ConfigError(f"local_planner.launch: cannot start {argv[0]!r}: {e}") from None
 
@@ -139,6 +154,17 @@ class _Shared:
             link.close()
         cls.nodes.clear()
         cls.links.clear()
+
+
+def _die_with_parent() -> None:
+    """In the launched node: SIGTERM it when its launcher dies.
+
+    Linux's ``PR_SET_PDEATHSIG``: a killed benchmark worker leaves no node behind.
+    """
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        ctypes.CDLL(None).prctl(1, signal.SIGTERM)  # 1 = PR_SET_PDEATHSIG
 
 
 def stop_process(proc: subprocess.Popen[Any], wait: float = STOP_WAIT_S) -> None:
@@ -178,13 +204,15 @@ class RosPlanner(EpisodeHooks):
         argv = list(self.params.launch or [])
         if argv[0] == "python":
             argv[0] = sys.executable
-        if options.namespace:
-            argv += self.remap_args(options.namespace)
+        ns = options.namespace
+        if ns:
+            # the node in the namespace; its absolute /clock and /tf follow Arena's there
+            argv += self.remap_args([("__ns", ns), *((t, f"{ns}{t}") for t in ABSOLUTE)])
         return argv
 
     @staticmethod
-    def remap_args(namespace: str) -> list[str]:
-        """Command-line words that put a launched node in ``namespace``."""
+    def remap_args(pairs: list[tuple[str, str]]) -> list[str]:
+        """Command-line words that remap ``(from, to)`` names of a launched node."""
         raise NotImplementedError
 
     def _connect(self) -> RosLink:
@@ -276,9 +304,9 @@ class Ros2Planner(RosPlanner):
     transport = ("arena.ros.ros2", "Ros2Transport")
 
     @staticmethod
-    def remap_args(namespace: str) -> list[str]:
-        """``--ros-args -r __ns:=<namespace>``."""
-        return ["--ros-args", "-r", f"__ns:={namespace}"]
+    def remap_args(pairs: list[tuple[str, str]]) -> list[str]:
+        """``--ros-args -r from:=to ...``."""
+        return ["--ros-args", *(w for a, b in pairs for w in ("-r", f"{a}:={b}"))]
 
 
 @LOCAL_PLANNERS.register("ros1", tags=("ros", "external"))
@@ -292,6 +320,6 @@ class Ros1Planner(RosPlanner):
     transport = ("arena.ros.ros1", "Ros1Transport")
 
     @staticmethod
-    def remap_args(namespace: str) -> list[str]:
-        """``__ns:=<namespace>`` (rospy's command-line remapping)."""
-        return [f"__ns:={namespace}"]
+    def remap_args(pairs: list[tuple[str, str]]) -> list[str]:
+        """``from:=to ...`` (rospy's command-line remapping)."""
+        return [f"{a}:={b}" for a, b in pairs]

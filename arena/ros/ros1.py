@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import atexit
 import importlib
-import math
 import threading
 import warnings
 from functools import cache
@@ -35,9 +34,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from arena.core.types import Pose2D
 from arena.ros.link import RosLink
-from arena.ros.messages import Fields
+from arena.ros.messages import Fields, received_pose
 from arena.ros.ros1_env import check_master, import_rospy, master_has_node
 from arena.ros.topics import Topic, ros1_type
 
@@ -109,9 +107,6 @@ def _time_class(kind: str) -> Any:
     rospy = import_rospy()
     return rospy.Time if kind == "time" else rospy.Duration
 
-
-def _yaw(q: Any) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 class _Process:
@@ -290,8 +285,7 @@ class Ros1Transport:
     def _on_goal(self, msg: Any) -> None:
         if self._own(msg):
             return
-        p = msg.pose
-        self.link.on_goal(Pose2D(float(p.position.x), float(p.position.y), _yaw(p.orientation)))
+        self.link.on_goal(received_pose(msg.pose))
         self._arrived.set()
 
     def _on_reset(self, request: Any) -> Any:

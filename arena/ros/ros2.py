@@ -17,15 +17,13 @@ from __future__ import annotations
 import array
 import atexit
 import importlib
-import math
 from functools import cache
 from typing import Any
 
 import numpy as np
 
-from arena.core.types import Pose2D
 from arena.ros.link import RosLink
-from arena.ros.messages import Fields
+from arena.ros.messages import Fields, received_pose
 from arena.ros.ros2_env import import_rclpy
 from arena.ros.topics import Topic
 
@@ -120,9 +118,6 @@ class _Process:
             rclpy.shutdown()
 
 
-def _yaw(q: Any) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
 
 class Ros2Transport:
     """rclpy side of one :class:`~arena.ros.link.RosLink` (see the module doc).
@@ -199,8 +194,7 @@ class Ros2Transport:
                              stamp.sec * 1_000_000_000 + stamp.nanosec)
 
     def _on_goal(self, msg: Any) -> None:
-        p = msg.pose
-        self.link.on_goal(Pose2D(float(p.position.x), float(p.position.y), _yaw(p.orientation)))
+        self.link.on_goal(received_pose(msg.pose))
 
     def _on_reset(self, request: Any, response: Any) -> Any:
         response.success, response.message = self.link.on_reset()

@@ -38,11 +38,18 @@ def import_rclpy() -> ModuleType:
     for module in ("rclpy", "geometry_msgs.msg", "nav_msgs.msg", "sensor_msgs.msg",
                    "visualization_msgs.msg", "rosgraph_msgs.msg", "std_srvs.srv"):
         try:
-            importlib.import_module(module)
+            mod = importlib.import_module(module)
         except ImportError as e:
             raise ConfigError(
                 f"the ROS 2 bridge needs {module.split('.')[0]} ({e}): {INSTALL_HINT}, "
                 "or source a ROS 2 install") from None
+        probe = next((v for k, v in vars(mod).items() if isinstance(v, type)
+                      and not k.startswith("_")), None)
+        if module.endswith(".msg") and not hasattr(probe, "get_fields_and_field_types"):
+            # ROS 1's genpy package of the same name, loaded earlier by the ROS 1 bridge
+            raise ConfigError(
+                f"the ROS 2 bridge imported {module} from {getattr(mod, '__file__', '?')}, which "
+                "is not a ROS 2 (rosidl) package; run ROS 1 and ROS 2 in separate processes")
     try:
         importlib.import_module("tf2_msgs.msg")
     except ImportError:

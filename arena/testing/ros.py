@@ -31,11 +31,15 @@ class LoopbackTransport:
         reply: the node's rule (default: a command far outside any robot's limits, which the
             planner must clip).
         subscribed: topic names the node subscribes to (default: every topic).
+        eager: answer inside each ``odom`` publish instead of in :meth:`poll`, as a client
+            library whose callbacks run on their own threads may deliver the answer before
+            ``publish`` returns.
     """
 
     def __init__(self, link: RosLink, reply: Reply | None = None,
-                 subscribed: set[str] | None = None) -> None:
+                 subscribed: set[str] | None = None, *, eager: bool = False) -> None:
         self.link = link
+        self.eager = eager
         self.reply = reply or (lambda sent: np.array([10.0, 5.0, 10.0]))
         self.subscribed = subscribed
         self.sent: dict[str, list[Fields]] = defaultdict(list)
@@ -50,6 +54,8 @@ class LoopbackTransport:
         """Keep the message."""
         self.advertise(topic, name)
         self.sent[name].append(fields)
+        if self.eager and topic.kind == "odom":
+            self._answer()  # a node whose answer arrives before publish returns (rospy)
 
     def subscribers(self, name: str) -> int:
         """1 for an advertised topic the node subscribes to, else 0."""
@@ -58,8 +64,12 @@ class LoopbackTransport:
         return int(self.subscribed is None or name in self.subscribed)
 
     def poll(self, timeout: float) -> None:
-        """Answer with the node's rule (silent when it returns ``None``)."""
+        """Answer with the node's rule (silent when it returns ``None``; eager: only at odom)."""
         self.polls += 1
+        if not self.eager:
+            self._answer()
+
+    def _answer(self) -> None:
         cmd = self.reply(self.sent)
         if cmd is not None:
             self.link.on_command(np.asarray(cmd, dtype=np.float64))

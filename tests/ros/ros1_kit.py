@@ -14,44 +14,28 @@ ROS 1 message packages in front of the ROS 2 ones other tests import).
 
 from __future__ import annotations
 
-import contextlib
-import json
-import os
-import signal
 import subprocess
-import sys
 from functools import cache
 from pathlib import Path
 from typing import Any
 
-import pytest
-
-from tests.ros.sandbox import REPO, netns_problem, unavailable
+from tests.ros import sandbox
+from tests.ros.sandbox import client_problem, netns_problem, unavailable
 
 SCENARIO = "tests.ros.ros1_scenario"
 #: The master's port inside the namespace (a fresh namespace has every port free).
 MASTER_PORT = 11311
 
 
-def unshare_cmd() -> list[str]:
-    """New network and PID namespaces (and a user one mapped to root when not root)."""
-    own = ["unshare", "-n", "-p", "--kill-child"]
-    return own if os.geteuid() == 0 else [own[0], "-r", *own[1:]]
-
-
 @cache
 def _problem() -> str | None:
     """Why the ROS 1 tests cannot run here, or ``None``."""
-    probe = subprocess.run(
-        [sys.executable, "-c", "from arena.ros.ros1_env import import_rospy; import_rospy()"],
-        capture_output=True, text=True, timeout=60, check=False, cwd=REPO)
-    if probe.returncode != 0:
-        lines = probe.stderr.strip().splitlines()
-        return f"needs Debian's ROS 1: {lines[-1] if lines else probe.returncode}"
-    if subprocess.run(["sh", "-c", "command -v rosmaster"], capture_output=True,
-                      check=False).returncode != 0:
-        return "needs rosmaster on PATH (Debian's ros-base)"
-    return netns_problem()
+    problem = client_problem("from arena.ros.ros1_env import import_rospy; import_rospy()",
+                             "Debian's ROS 1")
+    if problem is None and subprocess.run(["sh", "-c", "command -v rosmaster"],
+                                          capture_output=True, check=False).returncode != 0:
+        problem = "needs rosmaster on PATH (Debian's ros-base)"
+    return problem or netns_problem()
 
 
 def require_ros1() -> None:
@@ -66,25 +50,8 @@ def run_isolated(case: str, tmp: Path, *args: str, timeout: float = 60.0) -> dic
 
     ``timeout`` bounds the whole run; the scenario's master and nodes never outlive it.
     """
-    env = dict(os.environ, ROS_MASTER_URI=f"http://127.0.0.1:{MASTER_PORT}",
-               ROS_IP="127.0.0.1", ROS_HOME=str(tmp / "ros"), ROS_LOG_DIR=str(tmp / "ros" / "log"),
-               PYTHONUNBUFFERED="1")
-    env.pop("ROS_HOSTNAME", None)
-    cmd = [*unshare_cmd(), "sh", "-c", 'ip link set lo up && exec "$@"', "sh",
-           sys.executable, "-m", SCENARIO, case, *args]  # from the repository (tests.ros)
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            env=env, cwd=REPO, start_new_session=True)
-    try:
-        out, err = proc.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)  # unshare dies; --kill-child ends the namespace
-        out, err = proc.communicate()
-        pytest.fail(f"ROS 1 scenario {case} ran over {timeout:g} s:\n{err[-3000:]}")
-    finally:
-        with contextlib.suppress(ProcessLookupError):
-            os.killpg(proc.pid, signal.SIGKILL)
-    lines = out.strip().splitlines()
-    if proc.returncode != 0 or not lines:
-        pytest.fail(f"ROS 1 scenario {case} failed ({proc.returncode}):\n{err[-3000:]}")
-    result: dict[str, Any] = json.loads(lines[-1])
-    return result
+    env: dict[str, str | None] = {
+        "ROS_MASTER_URI": f"http://127.0.0.1:{MASTER_PORT}", "ROS_IP": "127.0.0.1",
+        "ROS_HOME": str(tmp / "ros"), "ROS_LOG_DIR": str(tmp / "ros" / "log"),
+        "ROS_HOSTNAME": None}
+    return sandbox.run_isolated(SCENARIO, case, *args, env=env, timeout=timeout)

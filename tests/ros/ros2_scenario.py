@@ -1,6 +1,6 @@
 """Scenarios of the ROS 2 bridge tests, each run by tests/ros/sandbox.py in its own network
-namespace (loopback only). Usage: ``python ros2_scenario.py CASE OUT_DIR``; the last line
-printed is the JSON result.
+and PID namespaces (loopback only). Usage, from the repository:
+``python -m tests.ros.ros2_scenario CASE OUT_DIR``; the last line printed is the JSON result.
 """
 
 from __future__ import annotations
@@ -12,8 +12,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # the repository: tests.ros.scenes
 
 EMPTY = 'map={"type": "empty", "width": 10, "height": 10}'
 #: No people, so the example node's plain pursuit reaches its goal.

@@ -5,6 +5,7 @@ The same link over rclpy and rospy is tested in test_ros2_bridge.py / test_ros1_
 """
 
 import math
+import sys
 
 import numpy as np
 import pytest
@@ -209,3 +210,37 @@ def test_transport_records_like_a_node():
     link = loopback_link()
     assert isinstance(link.transport, LoopbackTransport)
     assert link.transport.subscribers("/odom") == 0  # not advertised yet
+
+
+def test_an_answer_that_arrives_during_the_send_counts_for_that_frame(room):
+    planner = attach_loopback(_planner(timeout=0.2, startup_timeout=0.2), reply=pursuit_node,
+                              eager=True)
+    runner = _runner(room, planner)
+    assert runner.run() is Outcome.SUCCESS, runner.error
+
+
+def test_a_node_that_missed_its_first_frames_gets_the_frame_again(room):
+    """A silent node (its first answer lost) gets the latest frame again after a second."""
+    def node(sent):  # answers from the second odom on, as if the first never arrived
+        return pursuit_node(sent) if len(sent.get("/odom", [])) >= 2 else None
+
+    planner = attach_loopback(_planner(startup_timeout=5.0), reply=node)
+    runner = _runner(room, planner)
+    assert runner.run() is Outcome.SUCCESS
+    odoms = planner.link.transport.sent["/odom"]
+    assert odoms[0]["header"]["stamp"] == odoms[1]["header"]["stamp"]  # the repeat
+
+
+def test_remapped_topics_and_launch_arguments():
+    planner = attach_loopback(_planner(remap={"/scan": "/front/scan"}, namespace="/r1"))
+    opts = planner.link.options
+    assert opts.name("/scan") == "/front/scan" and opts.name("/odom") == "/r1/odom"
+    argv = Ros2Planner(RosPlannerParams(namespace="/r1", launch=["python", "-m", "x"])) \
+        ._launch_argv(RosPlannerParams(namespace="/r1").link_options())
+    assert argv[0] == sys.executable
+    assert argv[3:] == ["--ros-args", "-r", "__ns:=/r1", "-r", "/clock:=/r1/clock",
+                        "-r", "/tf:=/r1/tf", "-r", "/tf_static:=/r1/tf_static"]
+    with pytest.raises(ConfigError, match="not an absolute ROS name") as err:
+        LOCAL_PLANNERS.build({"type": "ros2", "remap": {"/scan": "front scan"}},
+                             path="navigation.local_planner")
+    assert "\n" not in str(err.value)

