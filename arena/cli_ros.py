@@ -137,7 +137,7 @@ def _run_command(version: str) -> Any:
         out: Annotated[Path | None, typer.Option("--out", "-o", help="output folder")] = None,
         plugin: PluginOption = None,
     ) -> None:
-        from arena.cli import _run
+        from arena.cli_run import run_episodes
         from arena.core.errors import ConfigError
         from arena.tasks.modules.interactive import InteractiveModule
 
@@ -151,8 +151,8 @@ def _run_command(version: str) -> Any:
             on_error=lambda msg: err_console.print(f"error: {msg}", highlight=False))
         console.print(f"{where}: {mode}, topics under '{namespace or '/'}'; goals on "
                       f"{namespace}/goal_pose, reset: {namespace}/arena/reset", highlight=False)
-        _run(items[0] if items else None, items[1:], episodes, None, None, seed, out, False,
-             None, False, plugin, _Session([ui]), realtime=mode == "realtime")
+        run_episodes(items[0] if items else None, items[1:], episodes, None, None, seed, out,
+                     False, None, False, plugin, _Session([ui]), realtime=mode == "realtime")
 
     name = "ROS 2" if version == "ros2" else "ROS 1"
     run_command.__doc__ = f"""Run episodes with robot 0 driven by a {name} node (docs/ros.md).

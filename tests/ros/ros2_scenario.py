@@ -51,6 +51,41 @@ def silent(out: Path) -> dict:
             "errors": errors}
 
 
+SUITE = """
+stages:
+  - name: room
+    episodes: 4
+    robot: jackal
+    map: empty_room
+    tm_robots: random
+    tm_obstacles: random
+    config:
+      RANDOM:
+        static: {min: 0, max: 0}
+        dynamic: {min: 0, max: 0}
+"""
+CONTEST = """
+contestants:
+  - name: ros_pursuit
+    local_planner: ros2
+    params: {mode: lockstep, namespace: auto,
+             launch: [python, -m, arena.ros.nodes.pure_pursuit]}
+"""
+
+
+def bench(out: Path) -> dict:
+    """arena bench with a ROS 2 contestant on two workers, each with its own node."""
+    (out / "suite.yaml").write_text(SUITE)
+    (out / "contest.yaml").write_text(CONTEST)
+    done = _arena("bench", str(out / "suite.yaml"), "--contest", str(out / "contest.yaml"),
+                  "--workers", "2", "-o", str(out / "bench"), timeout=240)
+    rows = [json.loads(f.read_text())
+            for f in sorted((out / "bench" / "episodes").glob("*/*/*.json"))]
+    return {"rc": done.returncode, "stderr": done.stderr[-2000:],
+            "outcomes": [r.get("outcome") for r in rows],
+            "contestants": sorted({r.get("contestant", "") for r in rows})}
+
+
 def topics(out: Path) -> dict:
     """A peer node hears the link's topics and talks back (values checked by the test)."""
     import rclpy
@@ -124,4 +159,5 @@ def topics(out: Path) -> dict:
 
 if __name__ == "__main__":
     case, out_dir = sys.argv[1], Path(sys.argv[2])
-    print(json.dumps({"episode": episode, "silent": silent, "topics": topics}[case](out_dir)))
+    cases = {"episode": episode, "silent": silent, "topics": topics, "bench": bench}
+    print(json.dumps(cases[case](out_dir)))

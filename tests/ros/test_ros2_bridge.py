@@ -50,6 +50,14 @@ def test_lockstep_run_with_the_example_node_reaches_its_goals(ros2, tmp_path):
     assert r["outcomes"] == ["success", "success"]
 
 
+def test_bench_scores_a_ros_contestant_on_two_workers(ros2, tmp_path):
+    """Each worker launches its own node in its own namespace (namespace: auto)."""
+    r = run_isolated(SCENARIO, "bench", str(tmp_path), env=ENV, timeout=300)
+    assert r["rc"] == 0, r["stderr"]
+    assert r["contestants"] == ["ros_pursuit"]
+    assert r["outcomes"] == ["success"] * 4
+
+
 def test_a_silent_node_costs_each_episode_not_the_run(ros2, tmp_path):
     r = run_isolated(SCENARIO, "silent", str(tmp_path), env=ENV, timeout=120)
     assert r["rc"] == 0, r["stderr"]
