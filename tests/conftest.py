@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+from collections.abc import Iterator
+
 import numpy as np
 import pytest
 
@@ -39,3 +42,20 @@ def standing_agents(positions, radius=0.3) -> AgentSpawn:
         waypoint_mode=np.zeros(n, dtype=np.int64),
         kinds=np.zeros(n, dtype=np.int64),
     )
+
+
+@pytest.fixture(autouse=True)
+def _plugins_env_restored() -> Iterator[None]:
+    """Each test leaves ``ARENA_PLUGINS`` as it found it.
+
+    ``--plugin`` exports the plugins to the environment for worker processes; a test whose
+    ``monkeypatch.delenv`` found the variable unset records nothing to restore, so without this
+    the plugin names leak into every later test of that pytest worker (and into the ``arena``
+    subprocesses those start, which then fail to import them).
+    """
+    before = os.environ.get("ARENA_PLUGINS")
+    yield
+    if before is None:
+        os.environ.pop("ARENA_PLUGINS", None)
+    else:
+        os.environ["ARENA_PLUGINS"] = before
