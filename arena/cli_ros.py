@@ -60,6 +60,7 @@ def _planner_spec(version: str, mode: str, namespace: str, timeout: float,
                   remap: list[str] | None) -> dict[str, Any]:
     """The ``navigation.local_planner`` block of a ROS run (``--remap`` as ``FROM:=TO``)."""
     from arena.core.errors import ConfigError
+    from arena.ros.link import check_topic
 
     spec: dict[str, Any] = {"type": version, "mode": mode, "namespace": namespace,
                             "timeout": timeout, "cmd_vel_stamped": cmd_vel_stamped}
@@ -71,6 +72,8 @@ def _planner_spec(version: str, mode: str, namespace: str, timeout: float,
         if not sep:
             raise ConfigError(f"--remap: expected FROM:=TO (e.g. /scan:=/front/scan), got "
                               f"{item!r}")
+        check_topic(source, field_name="--remap")
+        check_topic(target, field_name="--remap")
         pairs[source] = target
     if pairs:
         spec["remap"] = pairs
@@ -139,10 +142,12 @@ def _run_command(version: str) -> Any:
     ) -> None:
         from arena.cli_run import run_episodes
         from arena.core.errors import ConfigError
+        from arena.ros.link import check_namespace
         from arena.tasks.modules.interactive import InteractiveModule
 
         if mode not in ("realtime", "lockstep"):
             raise ConfigError(f"--mode: expected realtime or lockstep, got {mode!r}")
+        check_namespace(namespace, field_name="--namespace")
         spec = _planner_spec(version, mode, namespace, timeout, cmd_vel_stamped, launch, remap)
         where = _connect(version)
         items = ([config] if config else []) + list(overrides or [])

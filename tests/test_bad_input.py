@@ -220,6 +220,19 @@ Q = "task.obstacles.dynamic=0"  # fewer people: the cases that reach the first d
 CASES: list[tuple[str, list[str], list[str]]] = [
     # -- overrides: seeds, counts, names
     ("seed_true", ["run", "seed=true"], ["override 'seed=true'", "seed", "valid integer"]),
+    # -- ROS bridges: refused before any ROS traffic
+    ("ros2_mode", ["ros2", "run", "--mode", "fast"], ["--mode", "realtime or lockstep"]),
+    ("ros1_mode", ["ros1", "run", "--mode", "fast"], ["--mode", "realtime or lockstep"]),
+    ("ros2_namespace", ["ros2", "run", "--namespace", "robot 1"],
+     ["--namespace", "'robot 1'", "not a ROS namespace"]),
+    ("ros2_remap_form", ["ros2", "run", "--remap", "/scan"], ["--remap", "FROM:=TO"]),
+    ("ros2_remap_name", ["ros2", "run", "--remap", "/scan:=front scan"],
+     ["--remap", "'front scan'", "not an absolute ROS name"]),
+    ("ros2_planner_key", ["run", 'navigation.local_planner={"type": "ros2", "tmeout": 3}'],
+     ["navigation.local_planner.tmeout", "unknown key"]),
+    ("ros2_planner_remap", ["run", 'navigation.local_planner={"type": "ros2", '
+                                   '"remap": {"/scan": "x y"}}'],
+     ["navigation.local_planner.remap", "'x y'", "not an absolute ROS name"]),
     ("seed_negative", ["run", "seed=-1"],
      ["override 'seed=-1'", "seed", "greater than or equal to 0"]),
     ("seed_float", ["run", "seed=1.5"], ["override 'seed=1.5'", "seed"]),

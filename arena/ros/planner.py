@@ -90,15 +90,21 @@ class RosPlannerParams(BaseModel):
     @field_validator("remap")
     @classmethod
     def _remap(cls, v: dict[str, str]) -> dict[str, str]:
-        for source, target in v.items():
-            check_topic(source, field_name=f"remap key {source!r}")
-            check_topic(target, field_name=f"remap[{source!r}]")
+        try:
+            for source, target in v.items():
+                check_topic(source, field_name=f"key {source!r}")
+                check_topic(target, field_name=f"[{source!r}]")
+        except ConfigError as e:  # pydantic names the field
+            raise ValueError(str(e)) from None
         return v
 
     @field_validator("namespace")
     @classmethod
     def _namespace(cls, v: str) -> str:
-        return v if v == "auto" else check_namespace(v)
+        try:
+            return v if v == "auto" else check_namespace(v, field_name="namespace")
+        except ConfigError as e:  # pydantic names the field
+            raise ValueError(str(e).split(": ", 1)[1]) from None
 
     @field_validator("launch")
     @classmethod
