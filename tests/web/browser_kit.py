@@ -77,6 +77,12 @@ def editor_settled(page: Any) -> bool:
                               "!window.arenaEditor.checking"))
 
 
+def _placed(page: Any, key: str, point: tuple[float, float]) -> bool:
+    """Robot 0's ``start`` / ``goal`` in the editor is within 5 cm of ``point``."""
+    at = page.evaluate(f"(window.arenaEditor.scenario.robots[0] || {{}}).{key} || null")
+    return at is not None and abs(at[0] - point[0]) < 0.05 and abs(at[1] - point[1]) < 0.05
+
+
 def editor_click(page: Any, x: float, y: float) -> None:
     """Click the editor's canvas at the world point ``(x, y)`` (m)."""
     px, py = page.evaluate(f"window.arenaEditor.pageOf({x}, {y})")
@@ -111,11 +117,18 @@ def draw_scenario(page: Any, url: str, start: tuple[float, float], goal: tuple[f
     page.select_option("#editor-world-scenario", "")
     page.click("#editor-load-world")
     wait_until(lambda: page.inner_text("#editor-map-label") == "world small_office"
-               and editor_settled(page), what="small_office")
-    page.click("#editor-tool-start")
-    editor_click(page, *start)
-    page.click("#editor-tool-goal")
-    editor_click(page, *goal)
+               and editor_settled(page) and page.evaluate("!!window.arenaEditor.map"),
+               what="small_office")
+    for tool, point in (("start", start), ("goal", goal)):
+        # a click while the editor still swaps the map is lost: click again until it is placed
+        for _ in range(5):
+            page.click(f"#editor-tool-{tool}")
+            editor_click(page, *point)
+            with contextlib.suppress(AssertionError):
+                wait_until(lambda tool=tool, point=point: _placed(page, tool, point),
+                           timeout=5.0, what=f"the robot's {tool} at {point}")
+                break
+        assert _placed(page, tool, point), f"the robot's {tool} was not placed at {point}"
     page.click("#editor-tool-pedestrian")
     editor_click(page, *person)
     # placing a person switches to the waypoint tool for it
