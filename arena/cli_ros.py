@@ -130,8 +130,8 @@ def _run_command(version: str) -> Any:
         ] = False,
         launch: Annotated[
             str | None, typer.Option(help="start this node with the run, e.g. 'python -m "
-                                          "arena.ros.nodes.pure_pursuit' (ROS 1: "
-                                          "pure_pursuit_ros1)")
+                                          "arena.ros.nodes.local_planner' (ROS 1: "
+                                          "local_planner_ros1)")
         ] = None,
         episodes: Annotated[
             int | None, typer.Option("--episodes", "-n", help="number of episodes")

@@ -5,8 +5,8 @@
 Runs in loopback-only network and PID namespaces (it re-runs itself under ``unshare`` unless
 ``--here``; the PID namespace ends every node it started), ROS 2 with
 ``ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST``, ROS 1 with its own ``rosmaster --core``, and
-Arena's example node (``python -m arena.ros.nodes.pure_pursuit``, ROS 1:
-``pure_pursuit_ros1``) as the external planner:
+Arena's example node (``python -m arena.ros.nodes.local_planner``, ROS 1:
+``local_planner_ros1``; Arena's ``pure_pursuit`` behind ROS) as the external planner:
 
 * lock-step: episodes on an empty 10 × 10 m map without people; each step sends the
   episode's subscribed topics and waits for the node's ``/cmd_vel``. Prints simulated steps per
@@ -33,7 +33,9 @@ import sys  # noqa: E402
 import tempfile  # noqa: E402
 import time  # noqa: E402
 
-NODES = {"2": "arena.ros.nodes.pure_pursuit", "1": "arena.ros.nodes.pure_pursuit_ros1"}
+import numpy as np  # noqa: E402
+
+NODES = {"2": "arena.ros.nodes.local_planner", "1": "arena.ros.nodes.local_planner_ros1"}
 EMPTY = {"type": "empty", "width": 10, "height": 10}
 MASTER_PORT = 11311
 
@@ -53,16 +55,20 @@ def _run(ros: str, mode: str, items: list[str], realtime: bool = False):
 
 def lockstep(ros: str, steps: int) -> None:
     # episodes end at the goal (~120 steps); the first one pays for the node's start
-    episodes = 1 + max(1, steps // 120)
-    _, results, _ = _run(ros, "lockstep", [f"episodes={episodes}", "task.obstacles.dynamic=0",
-                                           "task.obstacles.static=0", "task.timeout=60"])
+    # 20 x 20 m, 15 m goals: long episodes, so the per-episode set-up (reset, map) is small
+    episodes = 1 + max(1, steps // 150)
+    _, results, _ = _run(ros, "lockstep", [
+        f"episodes={episodes}", "task.obstacles.dynamic=0", "task.obstacles.static=0",
+        "task.timeout=60", "map.width=20", "map.height=20", "task.robots.goal_distance=15"])
     later = results[1:]
     n = sum(r.steps for r in later)
     wall = sum(r.wall_time for r in later)
-    print(f"ROS {ros} lock-step: {n} steps in {wall:.2f} s = {n / wall:.0f} steps/s (first "
-          f"episode, with node start and discovery: {results[0].steps} steps in "
-          f"{results[0].wall_time:.2f} s); success {sum(r.outcome == 'success' for r in results)}"
-          f"/{len(results)}")
+    trip = float(np.mean([r.control_ms_mean for r in later]))
+    print(f"ROS {ros} lock-step: {n} steps in {wall:.2f} s = {n / wall:.0f} steps/s with each "
+          f"episode's set-up; round trip (topics out, command back) {trip:.2f} ms = "
+          f"{1e3 / trip:.0f} per s (first episode, with node start and discovery: "
+          f"{results[0].steps} steps in {results[0].wall_time:.2f} s); success "
+          f"{sum(r.outcome == 'success' for r in results)}/{len(results)}")
 
 
 def realtime(ros: str, people: int, seconds: float) -> None:

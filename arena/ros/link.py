@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 from arena.core.errors import ArenaError, ConfigError
 from arena.core.types import Pose2D
 from arena.live.frame import LiveFrame, LiveScene
-from arena.ros.messages import Fields, RosMessages
+from arena.ros.messages import Fields, RosMessages, sim_ns
 from arena.ros.topics import Topic
 
 Mode = Literal["lockstep", "realtime"]
@@ -129,6 +129,8 @@ class _Inbox:
 
     command: FloatArray | None = None
     command_frame: int = -1  # frames sent before the command arrived
+    stamped: bool = False  # the command had a stamp (TwistStamped): matched by time
+    answers: int = 0  # unstamped commands received over the link's life
     command_wall: float = -np.inf
     goals: list[Pose2D] = field(default_factory=list)
     resets: int = 0
@@ -149,6 +151,8 @@ class RosLink:
         self._cond = threading.Condition()
         self._inbox = _Inbox()
         self._frames = 0  # frames sent in this episode
+        self._frame_ns = 0  # the latest frame's simulated time (ns)
+        self._odoms = 0  # odom messages sent over the link's life (each gets one answer)
         self._answered = False  # a command came in this episode
         self._last_frame: LiveFrame | None = None
         self._goal_sent: tuple[float, ...] | None = None
@@ -161,7 +165,7 @@ class RosLink:
         """Start an episode: send the latched ``/tf_static`` and ``/map``."""
         self._goal_sent = None
         with self._cond:
-            self._frames, self._answered = 0, False
+            self._frames, self._frame_ns, self._answered = 0, 0, False
             self._inbox.command, self._inbox.command_frame = None, -1
         latched = self.messages.scene(scene)
         # the command topic is the node's: the link subscribes it and never publishes on it
@@ -214,22 +218,35 @@ class RosLink:
         messages.sort(key=lambda m: m[0].kind == "odom")
         for k, (topic, _, fields) in enumerate(messages):
             if not repeat and k == len(messages) - 1:
-                self._count_frame()
+                self._count_frame(frame)
+            if topic.kind == "odom":
+                with self._cond:
+                    self._odoms += 1
             transport.publish(topic, opts.name(topic.name), fields)
         if not repeat and not messages:
-            self._count_frame()
+            self._count_frame(frame)
 
-    def _count_frame(self) -> None:
+    def _count_frame(self, frame: LiveFrame) -> None:
         with self._cond:
             self._frames += 1
+            self._frame_ns = sim_ns(frame.time)
 
     # -- incoming (any thread) ------------------------------------------------------------------
     def on_command(self, command: FloatArray, stamp_ns: int | None = None) -> None:
-        """A ``cmd_vel`` ``[vx m/s, vy m/s, omega rad/s]`` arrived."""
+        """A ``cmd_vel`` ``[vx m/s, vy m/s, omega rad/s]`` arrived.
+
+        ``stamp_ns`` (TwistStamped's header, ns; ``None`` or 0: unstamped): a command stamped
+        before the latest frame's time answers an earlier frame, so lock-step does not take it
+        for the latest one.
+        """
         cmd = np.asarray(command, dtype=np.float64).reshape(3)
         with self._cond:
-            self._inbox.command = cmd
-            self._inbox.command_frame = self._frames
+            inbox = self._inbox
+            inbox.stamped = stamp_ns is not None and stamp_ns > 0
+            stale = inbox.stamped and stamp_ns < self._frame_ns  # type: ignore[operator]
+            inbox.answers += not inbox.stamped
+            inbox.command = cmd
+            inbox.command_frame = self._frames - 1 if stale else self._frames
             self._inbox.command_wall = time.monotonic()
             self._cond.notify_all()
 
@@ -285,10 +302,9 @@ class RosLink:
         resend_all = time.monotonic() + RESEND_ALL_S
         while True:
             with self._cond:
-                inbox = self._inbox
-                if inbox.command is not None and inbox.command_frame >= self._frames:
+                if self._answers_latest():
                     self._answered = True
-                    return inbox.command.copy()
+                    return self._inbox.command.copy()  # type: ignore[union-attr]
                 frames = self._frames
             now = time.monotonic()
             left = deadline - now
@@ -299,11 +315,32 @@ class RosLink:
                 resend = now + RESEND_S
                 if everything:
                     resend_all = now + RESEND_ALL_S
+                    with self._cond:  # answers lost before the node was connected: resync
+                        if self._odoms:  # expect one answer to the odom just sent again
+                            self._inbox.answers = min(self._inbox.answers, self._odoms - 1)
             if left <= 0:
                 raise NodeTimeout(
                     f"no {opts.name('/cmd_vel')} command within {wait:g} s (lock-step, after "
                     f"frame {frames}): the planner node does not answer")
             self.transport.poll(min(left, 0.1))
+
+    def _answers_latest(self) -> bool:
+        """The inbox's command answers the latest frame (called under the condition).
+
+        A stamped command answers the frames up to its stamp. Unstamped ones are counted: a
+        node answers each ``odom`` once, so the latest frame is answered when there are as
+        many answers as odoms were sent. Counting over the link's life, not just since the
+        frame went out, keeps an answer that arrives late (to an episode's last frame, which
+        no tick consumes) from being taken for the next frame's, which would make every
+        later command one frame late. Without odom subscribers, any command that came after
+        the frame went out answers it.
+        """
+        inbox = self._inbox
+        if inbox.command is None:
+            return False
+        if inbox.stamped or not self._odoms:
+            return inbox.command_frame >= self._frames
+        return inbox.answers >= self._odoms
 
     def close(self) -> None:
         """Close the transport."""

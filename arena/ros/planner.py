@@ -194,6 +194,9 @@ class RosPlanner(EpisodeHooks):
     Params = RosPlannerParams
     #: The transport's module and class (imported on first use: rclpy / rospy are extras).
     transport: ClassVar[tuple[str, str]]
+    #: How a launched node takes remaps: ``(args marker, flag before each)``, or ``None`` for
+    #: bare ``from:=to`` words.
+    remap_flag: ClassVar[tuple[str, str] | None]
 
     def __init__(self, params: RosPlannerParams | None = None) -> None:
         self.params = params or RosPlannerParams()
@@ -216,10 +219,16 @@ class RosPlanner(EpisodeHooks):
             argv += self.remap_args([("__ns", ns), *((t, f"{ns}{t}") for t in ABSOLUTE)])
         return argv
 
-    @staticmethod
-    def remap_args(pairs: list[tuple[str, str]]) -> list[str]:
-        """Command-line words that remap ``(from, to)`` names of a launched node."""
-        raise NotImplementedError
+    @classmethod
+    def remap_args(cls, pairs: list[tuple[str, str]]) -> list[str]:
+        """Command-line words that remap ``(from, to)`` names of a launched node.
+
+        ROS 2: ``--ros-args -r from:=to ...``; ROS 1: ``from:=to ...``.
+        """
+        words = [f"{a}:={b}" for a, b in pairs]
+        if cls.remap_flag is None:
+            return words
+        return [cls.remap_flag[0], *(w for word in words for w in (cls.remap_flag[1], word))]
 
     def _connect(self) -> RosLink:
         if self.link is None:
@@ -309,10 +318,7 @@ class Ros2Planner(RosPlanner):
 
     transport = ("arena.ros.ros2", "Ros2Transport")
 
-    @staticmethod
-    def remap_args(pairs: list[tuple[str, str]]) -> list[str]:
-        """``--ros-args -r from:=to ...``."""
-        return ["--ros-args", *(w for a, b in pairs for w in ("-r", f"{a}:={b}"))]
+    remap_flag = ("--ros-args", "-r")
 
 
 @LOCAL_PLANNERS.register("ros1", tags=("ros", "external"))
@@ -325,7 +331,4 @@ class Ros1Planner(RosPlanner):
 
     transport = ("arena.ros.ros1", "Ros1Transport")
 
-    @staticmethod
-    def remap_args(pairs: list[tuple[str, str]]) -> list[str]:
-        """``from:=to ...`` (rospy's command-line remapping)."""
-        return [f"{a}:={b}" for a, b in pairs]
+    remap_flag = None  # rospy reads bare from:=to words

@@ -44,7 +44,6 @@ class LoopbackTransport:
         self.subscribed = subscribed
         self.sent: dict[str, list[Fields]] = defaultdict(list)
         self.advertised: dict[str, Topic] = {}
-        self.polls = 0
 
     def advertise(self, topic: Topic, name: str) -> None:
         """Note the topic."""
@@ -65,7 +64,6 @@ class LoopbackTransport:
 
     def poll(self, timeout: float) -> None:
         """Answer with the node's rule (silent when it returns ``None``; eager: only at odom)."""
-        self.polls += 1
         if not self.eager:
             self._answer()
 

@@ -7,7 +7,7 @@ received as JSON.
 
 Usage: ``python ros1_peer.py probe`` with ``ROS_MASTER_URI`` set; it exits once done. (The
 episode case is answered by Arena's shipped node,
-:mod:`arena.ros.nodes.pure_pursuit_ros1`.)
+:mod:`arena.ros.nodes.local_planner_ros1`.)
 """
 
 from __future__ import annotations

@@ -127,15 +127,16 @@ def reset_calls(service: str, *links: RosLink) -> list[int]:
 
 
 def episode(out: str, episodes: str = "2") -> dict[str, Any]:
-    """``arena ros1 run`` in lock-step, its ``--launch`` starting the shipped ROS 1
-    pure-pursuit node; the episodes' summary rows."""
+    """``arena ros1 run`` in lock-step, its ``--launch`` starting the shipped ROS 1 node
+    (Arena's pure pursuit at 0.6 m/s); the episodes' summary rows."""
     import csv
 
     argv = [sys.executable, "-c", "from arena.cli import main; main()", "ros1", "run",
             "map.type=empty", "map.width=10", "map.height=10", "output.video=false",
             "task.obstacles.static=0", "task.obstacles.dynamic=4", "task.timeout=40",
             "task.robots.goal_distance=6", "--mode", "lockstep", "--timeout", "10",
-            "--launch", "python -m arena.ros.nodes.pure_pursuit_ros1", "-n", episodes,
+            "--launch", "python -m arena.ros.nodes.local_planner_ros1 --params "
+            "'{\"max_speed\": 0.6}'", "-n", episodes,
             "-o", out]
     done = subprocess.run(argv, capture_output=True, text=True, timeout=WAIT_S * 3, check=False)
     if done.returncode != 0:

@@ -32,7 +32,7 @@ def _outcomes(out: Path) -> list[str]:
 def episode(out: Path) -> dict:
     """arena ros2 run, lock-step, with the example node launched: it reaches its goals."""
     done = _arena("ros2", "run", EMPTY, *NO_PEOPLE, "episodes=2", "--mode", "lockstep",
-                  "--launch", "python -m arena.ros.nodes.pure_pursuit", "-o", str(out / "run"))
+                  "--launch", "python -m arena.ros.nodes.local_planner", "-o", str(out / "run"))
     return {"rc": done.returncode, "stderr": done.stderr[-2000:],
             "outcomes": _outcomes(out / "run") if done.returncode == 0 else []}
 
@@ -69,7 +69,7 @@ contestants:
   - name: ros_pursuit
     local_planner: ros2
     params: {mode: lockstep, namespace: auto,
-             launch: [python, -m, arena.ros.nodes.pure_pursuit]}
+             launch: [python, -m, arena.ros.nodes.local_planner]}
 """
 
 
